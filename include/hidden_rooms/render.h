@@ -1,0 +1,44 @@
+#pragma once
+
+#include <optional>
+#include <set>
+#include <string>
+
+#include <opencv2/core.hpp>
+
+#include "hidden_rooms/doors_file.h"
+#include "hidden_rooms/environment.h"
+#include "hidden_rooms/occupancy_grid.h"
+
+namespace hidden_rooms {
+
+struct RenderOptions {
+  double resolution = 0.05;  // metres per cell
+  // Wall thickness in metres; unset: the environment's <wall_thickness>, else kDefaultWallThickness.
+  std::optional<double> wall_thickness;
+  double door_width = 0.9;   // width of the gap cut at every open door, metres
+  double margin = 1.0;       // unknown border around the environment, metres
+  static constexpr double kDefaultWallThickness = 0.15;
+};
+
+// Ground truth of an environment in the map frame (the map frame is the environment frame: the grid's
+// origin is its lower-left corner in environment coordinates).
+struct RenderedEnvironment {
+  OccupancyGrid map;        // free inside spaces, walls occupied, unknown outside
+  cv::Mat1w space_labels;   // per cell: 1 + index of the space whose free cells it belongs to, 0 elsewhere
+  DoorsFile closed_doors;   // the closed doors, frame "map"
+};
+
+// Renders the environment. Doors in `closed_door_indices`, doors whose status is CLOSED and exterior doors
+// (joining fewer than two spaces) are drawn as wall; every other door gets a gap of `door_width`.
+RenderedEnvironment renderEnvironment(const Environment& environment, const std::set<int>& closed_door_indices,
+                                      const RenderOptions& options = RenderOptions());
+
+// Colour preview for people: spaces tinted, walls black, open doors green, closed doors red with their
+// numbers.
+cv::Mat3b renderPreview(const Environment& environment, const RenderedEnvironment& rendered);
+
+// Writes a label image as PNG: 8-bit when every label fits, else 16-bit. Throws InputError on failure.
+void saveLabelImage(const cv::Mat1w& labels, const std::string& path);
+
+}  // namespace hidden_rooms

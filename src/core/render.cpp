@@ -1,0 +1,209 @@
+#include "hidden_rooms/render.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "hidden_rooms/input_error.h"
+
+namespace hidden_rooms {
+
+namespace {
+
+constexpr int kSubpixelBits = 8;  // cv::fillPoly shift: polygon vertices with 1/256 cell precision
+constexpr double kMaxCells = 4e8;
+constexpr double kSameLineAngle = 10.0 * 3.14159265358979323846 / 180.0;
+// Largest distance (metres) between the two drawings of one wall by the two spaces it separates.
+constexpr double kMaxDoubleWallOffset = 0.5;
+
+// Map-frame polygon -> OpenCV integer vertices (cell centres at integer coordinates, fixed point).
+std::vector<cv::Point> toCvPolygon(const OccupancyGrid& grid, const Polygon& polygon) {
+  std::vector<cv::Point> points;
+  for (const Point2& p : polygon) {
+    const Point2 image = grid.toImage(p) - Point2(0.5, 0.5);
+    points.emplace_back(static_cast<int>(std::lround(image.x() * (1 << kSubpixelBits))),
+                        static_cast<int>(std::lround(image.y() * (1 << kSubpixelBits))));
+  }
+  return points;
+}
+
+// Rectangle centred on segment [a, b] with half-width `half_across`, extended by `cap` beyond both ends.
+Polygon segmentRectangle(const Point2& a, const Point2& b, double half_across, double cap) {
+  const Point2 along = (b - a).norm() > 0 ? Point2((b - a).normalized()) : Point2(1, 0);
+  const Point2 across(-along.y(), along.x());
+  const Point2 start = a - cap * along, end = b + cap * along;
+  return {start + half_across * across, end + half_across * across, end - half_across * across,
+          start - half_across * across};
+}
+
+template <typename T>
+void fillPolygon(cv::Mat_<T>* image, const OccupancyGrid& grid, const Polygon& polygon, T value) {
+  if (polygon.size() < 3) return;
+  const std::vector<std::vector<cv::Point>> polygons{toCvPolygon(grid, polygon)};
+  cv::fillPoly(*image, polygons, cv::Scalar(value), cv::LINE_8, kSubpixelBits);
+}
+
+double angleBetweenLines(double a, double b) {
+  const double difference = std::fmod(std::abs(a - b), 3.14159265358979323846);
+  return std::min(difference, 3.14159265358979323846 - difference);
+}
+
+bool isOpen(const Door& door, int index, const std::set<int>& closed) {
+  return door.space_indices.size() >= 2 && door.status != DoorStatus::kClosed && closed.count(index) == 0;
+}
+
+void validate(const RenderOptions& options, double wall_thickness) {
+  auto positive = [](double value) { return std::isfinite(value) && value > 0.0; };
+  if (!positive(options.resolution)) throw InputError("render options", "resolution must be positive");
+  if (!positive(options.door_width)) throw InputError("render options", "door width must be positive");
+  if (!positive(wall_thickness)) throw InputError("render options", "wall thickness must be positive");
+  if (!std::isfinite(options.margin) || options.margin < 0.0)
+    throw InputError("render options", "margin must be zero or positive");
+}
+
+}  // namespace
+
+RenderedEnvironment renderEnvironment(const Environment& environment, const std::set<int>& closed_door_indices,
+                                      const RenderOptions& options) {
+  const double thickness =
+      options.wall_thickness.value_or(environment.wall_thickness.value_or(RenderOptions::kDefaultWallThickness));
+  validate(options, thickness);
+  for (int index : closed_door_indices)
+    if (index < 0 || index >= static_cast<int>(environment.doors.size()))
+      throw InputError("render options", "closed door index " + std::to_string(index) + " does not exist");
+
+  const auto [low, high] = environment.bounds();
+  const double resolution = options.resolution;
+  RenderedEnvironment result;
+  OccupancyGrid& grid = result.map;
+  grid.resolution = resolution;
+  grid.origin = ((low.array() - options.margin) / resolution).floor() * resolution;
+  const Eigen::Array2d cells = ((high - grid.origin).array() + options.margin) / resolution;
+  if (cells.x() * cells.y() > kMaxCells)
+    throw InputError("render options", "the map would have more than 4e8 cells: raise the resolution");
+  grid.cells.create(static_cast<int>(std::ceil(cells.y())), static_cast<int>(std::ceil(cells.x())));
+  grid.cells.setTo(OccupancyGrid::kUnknown);
+  result.space_labels = cv::Mat1w::zeros(grid.cells.size());
+
+  for (size_t s = 0; s < environment.spaces.size(); ++s) {
+    fillPolygon<int8_t>(&grid.cells, grid, environment.spaces[s].outline, OccupancyGrid::kFree);
+    fillPolygon<uint16_t>(&result.space_labels, grid, environment.spaces[s].outline, static_cast<uint16_t>(s + 1));
+  }
+
+  // Open doors. Real floor plans often draw the wall between two spaces twice, once per space and up to
+  // kMaxDoubleWallOffset apart, with the portal on one of the two lines: the gap is cut through every wall of
+  // the joined spaces parallel to the door within that offset, and through any other wall the door lies on.
+  std::vector<int> open_doors;
+  for (size_t d = 0; d < environment.doors.size(); ++d)
+    if (isOpen(environment.doors[d], static_cast<int>(d), closed_door_indices)) open_doors.push_back(static_cast<int>(d));
+  const double on_wall_tolerance = std::max(thickness, 2.0 * resolution);
+  struct WallPiece {
+    Point2 a, b;
+    std::vector<std::pair<double, double>> solid{{0.0, 1.0}};  // parameter intervals along a -> b left standing
+  };
+  std::vector<WallPiece> walls;
+  std::vector<double> door_half_depth(environment.doors.size(), 0.5 * thickness + resolution);
+  for (size_t s = 0; s < environment.spaces.size(); ++s) {
+    for (const LineSegment& segment : environment.spaces[s].segments) {
+      const double length = (segment.b - segment.a).norm();
+      if (segment.segment_class != SegmentClass::kWall || length <= 1e-9) continue;
+      WallPiece wall{segment.a, segment.b};
+      const Point2 direction = (wall.b - wall.a) / length;
+      const double wall_angle = std::atan2(direction.y(), direction.x());
+      for (int d : open_doors) {
+        const Door& door = environment.doors[d];
+        if (angleBetweenLines(wall_angle, door.wall_angle) > kSameLineAngle) continue;
+        const double t = projectionParameter(door.centre, wall.a, wall.b);
+        const double offset = std::abs(direction.x() * (door.centre.y() - wall.a.y()) -
+                                       direction.y() * (door.centre.x() - wall.a.x()));
+        const double half_cut = (0.5 * options.door_width + 0.5 * thickness) / length;
+        const bool joins_space = std::find(door.space_indices.begin(), door.space_indices.end(),
+                                           static_cast<int>(s)) != door.space_indices.end();
+        const bool on_this_wall = distanceToSegment(door.centre, wall.a, wall.b) <= on_wall_tolerance;
+        const bool double_wall = joins_space && offset <= kMaxDoubleWallOffset && t > -half_cut && t < 1.0 + half_cut;
+        if (!on_this_wall && !double_wall) continue;
+        door_half_depth[d] = std::max(door_half_depth[d], offset + 0.5 * thickness + resolution);
+        std::vector<std::pair<double, double>> remaining;
+        for (const auto& [t0, t1] : wall.solid) {
+          if (t - half_cut > t0) remaining.emplace_back(t0, std::min(t1, t - half_cut));
+          if (t + half_cut < t1) remaining.emplace_back(std::max(t0, t + half_cut), t1);
+        }
+        wall.solid.swap(remaining);
+      }
+      walls.push_back(std::move(wall));
+    }
+  }
+  for (int d : open_doors) {
+    const Door& door = environment.doors[d];
+    const Point2 along(std::cos(door.wall_angle), std::sin(door.wall_angle));
+    const double half = 0.5 * options.door_width;
+    fillPolygon<int8_t>(&grid.cells, grid,
+                        segmentRectangle(door.centre - half * along, door.centre + half * along, door_half_depth[d], 0.0),
+                        OccupancyGrid::kFree);
+  }
+  for (const WallPiece& wall : walls)
+    for (const auto& [t0, t1] : wall.solid)
+      if (t1 > t0)
+        fillPolygon<int8_t>(&grid.cells, grid,
+                            segmentRectangle(wall.a + t0 * (wall.b - wall.a), wall.a + t1 * (wall.b - wall.a),
+                                             0.5 * thickness, 0.5 * thickness),
+                            OccupancyGrid::kOccupied);
+  result.space_labels.setTo(0, grid.cells != OccupancyGrid::kFree);
+
+  result.closed_doors.frame = "map";
+  for (size_t d = 0; d < environment.doors.size(); ++d) {
+    const Door& door = environment.doors[d];
+    if (closed_door_indices.count(static_cast<int>(d)) == 0 && door.status != DoorStatus::kClosed) continue;
+    MapDoor closed;
+    closed.id = door.number;
+    closed.position = door.centre;
+    closed.width = options.door_width;
+    closed.orientation = door.orientation;
+    result.closed_doors.doors.push_back(closed);
+  }
+  return result;
+}
+
+cv::Mat3b renderPreview(const Environment& environment, const RenderedEnvironment& rendered) {
+  const OccupancyGrid& grid = rendered.map;
+  cv::Mat3b preview;
+  cv::cvtColor(grid.toGreyImage(), preview, cv::COLOR_GRAY2BGR);
+  // Pastel tint per space, from a fixed hue sequence (golden-angle steps).
+  for (int row = 0; row < preview.rows; ++row)
+    for (int col = 0; col < preview.cols; ++col) {
+      const int label = rendered.space_labels(row, col);
+      if (label == 0) continue;
+      const double hue = std::fmod(label * 137.508, 360.0);
+      cv::Mat3b hsv(1, 1, cv::Vec3b(static_cast<uchar>(hue / 2), 60, 245)), bgr;
+      cv::cvtColor(hsv, bgr, cv::COLOR_HSV2BGR);
+      preview(row, col) = bgr(0, 0);
+    }
+  const int radius = std::max(3, static_cast<int>(std::lround(0.3 / grid.resolution)));
+  std::set<int> closed_numbers;
+  for (const MapDoor& door : rendered.closed_doors.doors) closed_numbers.insert(door.id);
+  for (const Door& door : environment.doors) {
+    const Point2 image = grid.toImage(door.centre);
+    const cv::Point centre(static_cast<int>(image.x()), static_cast<int>(image.y()));
+    const bool closed = closed_numbers.count(door.number) > 0;
+    if (door.space_indices.size() < 2 && !closed) continue;
+    const cv::Scalar colour = closed ? cv::Scalar(0, 0, 220) : cv::Scalar(0, 170, 0);
+    cv::circle(preview, centre, radius, colour, closed ? cv::FILLED : 2, cv::LINE_AA);
+    if (closed)
+      cv::putText(preview, std::to_string(door.number), centre + cv::Point(radius + 2, -radius - 2),
+                  cv::FONT_HERSHEY_SIMPLEX, 0.45, colour, 1, cv::LINE_AA);
+  }
+  return preview;
+}
+
+void saveLabelImage(const cv::Mat1w& labels, const std::string& path) {
+  double max_label = 0.0;
+  if (!labels.empty()) cv::minMaxLoc(labels, nullptr, &max_label);
+  cv::Mat image;
+  if (max_label <= 255.0) labels.convertTo(image, CV_8U);
+  else image = labels;
+  if (!cv::imwrite(path, image)) throw InputError(path, "cannot write label image");
+}
+
+}  // namespace hidden_rooms

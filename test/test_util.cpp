@@ -1,0 +1,96 @@
+#include "test_util.h"
+
+#include <sys/wait.h>
+
+#include <cstdio>
+
+#include <opencv2/imgproc.hpp>
+
+namespace hidden_rooms::testing {
+
+cv::Mat1b reachableFreeCells(const OccupancyGrid& grid, int col, int row) {
+  cv::Mat1b passable = (grid.cells == OccupancyGrid::kFree);
+  cv::Mat1b mask = cv::Mat1b::zeros(grid.height() + 2, grid.width() + 2);
+  if (passable(row, col) == 0) return cv::Mat1b::zeros(grid.height(), grid.width());
+  cv::floodFill(passable, mask, cv::Point(col, row), 128, nullptr, 0, 0,
+                4 | cv::FLOODFILL_MASK_ONLY | (255 << 8));
+  return mask(cv::Rect(1, 1, grid.width(), grid.height())).clone();
+}
+
+}  // namespace hidden_rooms::testing
+
+namespace hidden_rooms::testing {
+
+CommandResult runCommand(const std::string& command) {
+  CommandResult result;
+  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
+  if (pipe == nullptr) return result;
+  char buffer[4096];
+  size_t read = 0;
+  while ((read = fread(buffer, 1, sizeof(buffer), pipe)) > 0) result.output.append(buffer, read);
+  const int status = pclose(pipe);
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return result;
+}
+
+namespace {
+
+std::string point(int x, int y) {
+  return "<point x=\"" + std::to_string(x) + "\" y=\"" + std::to_string(y) + "\"/>";
+}
+
+std::string segment(const std::string& id, int x0, int y0, int x1, int y1, const std::string& segment_class,
+                    const std::string& status = "") {
+  std::string text = "<linesegment id=\"" + id + "\">" + point(x0, y0) + point(x1, y1) + "<class>" +
+                     segment_class + "</class><type>EXPLICIT</type><features>NORMAL</features>";
+  if (!status.empty()) text += "<status>" + status + "</status>";
+  return text + "</linesegment>";
+}
+
+std::string portalLink(const std::string& segment_id, const std::string& a, const std::string& b) {
+  return "<portal><linesegment>" + segment_id + "</linesegment><class>HORIZONTAL</class><type>EXPLICIT</type>"
+         "<features>NORMAL</features><direction>BOTH</direction><target><id>" + a + "</id><id>" + b +
+         "</id></target></portal>";
+}
+
+std::string space(const std::string& id, const std::string& label, const std::vector<std::pair<int, int>>& outline,
+                  const std::string& segments, const std::string& portals) {
+  std::string text = "<space id=\"" + id + "\"><labels><type>X</type><label>" + label + "</label></labels>";
+  text += "<bounding_polygon>";
+  for (const auto& [x, y] : outline) text += point(x, y);
+  text += "</bounding_polygon><space_representation>" + segments + "</space_representation><portals>" + portals +
+          "</portals></space>";
+  return text;
+}
+
+}  // namespace
+
+std::string corridorWithTwoRoomsXml(const std::string& door1_status, const std::string& extra_portal) {
+  const std::string corridor = space(
+      "corridor", "CORRIDOR", {{0, 0}, {0, 40}, {200, 40}, {200, 0}},
+      segment("c1", 0, 0, 0, 40, "WALL") + segment("c2", 0, 40, 40, 40, "WALL") +
+          segment("door_a", 40, 40, 40, 40, "PORTAL", door1_status) + segment("c3", 40, 40, 140, 40, "WALL") +
+          segment("door_b", 140, 40, 140, 40, "PORTAL") + segment("c4", 140, 40, 200, 40, "WALL") +
+          segment("c5", 200, 40, 200, 0, "WALL") + segment("c6", 200, 0, 0, 0, "WALL"),
+      portalLink("door_a", "corridor", "room_a") + portalLink("door_b", "corridor", "room_b"));
+  std::string room_a_segments = segment("a1", 0, 40, 40, 40, "WALL") +
+                                segment("door_a", 40, 40, 40, 40, "PORTAL", door1_status) +
+                                segment("a2", 40, 40, 80, 40, "WALL") + segment("a3", 80, 40, 80, 120, "WALL") +
+                                segment("a4", 80, 120, 0, 120, "WALL") + segment("a5", 0, 120, 0, 40, "WALL");
+  if (!extra_portal.empty()) room_a_segments += extra_portal;
+  const std::string room_a = space("room_a", "OFFICE", {{0, 40}, {80, 40}, {80, 120}, {0, 120}}, room_a_segments,
+                                   portalLink("door_a", "room_a", "corridor"));
+  const std::string room_b = space(
+      "room_b", "OFFICE", {{80, 40}, {200, 40}, {200, 120}, {80, 120}},
+      segment("b1", 80, 40, 140, 40, "WALL") + segment("door_b", 140, 40, 140, 40, "PORTAL") +
+          segment("b2", 140, 40, 200, 40, "WALL") + segment("b3", 200, 40, 200, 120, "WALL") +
+          segment("b4", 200, 120, 80, 120, "WALL") + segment("b5", 80, 120, 80, 40, "WALL"),
+      portalLink("door_b", "room_b", "corridor"));
+  return "<?xml version=\"1.0\"?><building id=\"test\"><name>corridor_with_two_rooms</name><scale>"
+         "<represented_distance><value>20</value><um>pixel</um></represented_distance>"
+         "<real_distance><value>100</value><um>cm</um></real_distance></scale>"
+         "<building_type><main_type>OFFICE</main_type></building_type><floor><spaces>" +
+         corridor + room_a + room_b + "</spaces></floor></building>";
+}
+
+}  // namespace hidden_rooms::testing

@@ -1,0 +1,78 @@
+#pragma once
+
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <opencv2/core.hpp>
+
+#include "hidden_rooms/occupancy_grid.h"
+
+namespace hidden_rooms::testing {
+
+// The shared data folder (thesis environments, closed-door benchmark). Empty when it is absent; tests that
+// need it skip then, unless HIDDEN_ROOMS_REQUIRE_SHARED=1 (set by scripts/test.sh), when they fail.
+inline std::string sharedDir() {
+  const char* from_env = std::getenv("HIDDEN_ROOMS_SHARED_DIR");
+  std::string dir = from_env != nullptr ? from_env : HIDDEN_ROOMS_SHARED_DIR;
+  if (std::filesystem::is_directory(dir + "/data")) return dir;
+  return "";
+}
+
+inline bool sharedRequired() {
+  const char* flag = std::getenv("HIDDEN_ROOMS_REQUIRE_SHARED");
+  return flag != nullptr && std::string(flag) == "1";
+}
+
+#define HIDDEN_ROOMS_REQUIRE_SHARED_DATA()                                                  \
+  do {                                                                                      \
+    if (::hidden_rooms::testing::sharedDir().empty()) {                                     \
+      if (::hidden_rooms::testing::sharedRequired()) FAIL() << "shared data folder missing"; \
+      GTEST_SKIP() << "shared data folder not found";                                       \
+    }                                                                                       \
+  } while (0)
+
+// All environment XML files of the shared data, sorted.
+inline std::vector<std::string> sharedEnvironmentFiles() {
+  std::vector<std::string> files;
+  const std::string root = sharedDir() + "/data/environments";
+  if (!std::filesystem::is_directory(root)) return files;
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(root))
+    if (entry.path().extension() == ".xml") files.push_back(entry.path().string());
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+// A fresh empty temporary folder for one test.
+inline std::string makeTempDir(const std::string& name) {
+  const auto dir = std::filesystem::temp_directory_path() / ("hidden_rooms_test_" + name);
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir.string();
+}
+
+// Cells reachable from (col, row) through free cells (4-connected), as a 0/255 mask.
+cv::Mat1b reachableFreeCells(const OccupancyGrid& grid, int col, int row);
+
+}  // namespace hidden_rooms::testing
+
+namespace hidden_rooms::testing {
+
+struct CommandResult {
+  int exit_code = -1;
+  std::string output;  // stdout and stderr together
+};
+
+// Runs a shell command and captures its output and exit code.
+CommandResult runCommand(const std::string& command);
+
+// A tiny environment in the thesis schema (0.05 m per pixel): a 10 m x 2 m corridor (pixels x 0..200,
+// y 0..40) under two rooms, A (x 0..80, y 40..120) and B (x 80..200, y 40..120), each with one door to the
+// corridor (door 1 at (40, 40) into A, door 2 at (140, 40) into B). `extra_portal` adds a PORTAL segment at a
+// pixel position to room A (to build files with a door on no wall).
+std::string corridorWithTwoRoomsXml(const std::string& door1_status = "", const std::string& extra_portal = "");
+
+}  // namespace hidden_rooms::testing
