@@ -6,6 +6,8 @@
 set -euo pipefail
 
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+# ROS 1 on Debian runs on Debian's Python: keep /usr/bin ahead of any other python3 on PATH.
+export PATH="/usr/bin:$PATH"
 WORLD="$ROOT/worlds/medium_1.xml"
 GUI=false
 while [ $# -gt 0 ]; do

@@ -448,7 +448,8 @@ std::string environmentToXml(const Environment& environment) {
     if (std::abs(twice_area) > 1e-12) centroid /= 3.0 * twice_area;
     else if (!pixels.empty()) centroid = pixels.front();
     out.OpenElement("centroid");
-    writePoint(&out, Point2(std::round(centroid.x()), std::round(centroid.y())));
+    // Whole pixels as in the thesis's files; the bias keeps x.5 from flipping with rounding noise.
+    writePoint(&out, Point2(std::floor(centroid.x() + 0.5 + 1e-6), std::floor(centroid.y() + 0.5 + 1e-6)));
     out.CloseElement();
     out.OpenElement("bounding_box");
     const std::pair<const char*, std::function<bool(const Point2&, const Point2&)>> extremes[] = {
