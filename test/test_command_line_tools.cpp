@@ -1,5 +1,6 @@
 // The command-line tools as a user runs them: outputs on good input, a clear message and exit code 2 on bad.
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 
 #include <filesystem>
 #include <fstream>
@@ -17,6 +18,7 @@ using testing::runCommand;
 
 const std::string kRender = RENDER_ENVIRONMENT_BIN;
 const std::string kGenerate = GENERATE_WORLD_BIN;
+const std::string kPredict = PREDICT_ROOMS_OFFLINE_BIN;
 
 std::string writeSynthetic(const std::string& dir, const std::string& xml) {
   const std::string path = dir + "/world.xml";
@@ -82,9 +84,85 @@ TEST(GenerateWorldTool, BadInputGivesAClearErrorAndExitCode2) {
   expectBadInput(kGenerate + " --seed 1 --size small", "--out");
 }
 
+// The synthetic hidden-room case written as files: DIR/case/map.yaml, DIR/case/doors.yaml, DIR/case/truth.png.
+std::string syntheticCase(const std::string& dir) {
+  OccupancyGrid map;
+  DoorsFile doors;
+  cv::Mat1w truth;
+  testing::syntheticHiddenRoomA(&map, &doors, &truth);
+  std::filesystem::create_directories(dir + "/case");
+  saveMap(map, dir + "/case/map");
+  saveDoors(doors, dir + "/case/doors.yaml");
+  cv::Mat1b truth8;
+  truth.convertTo(truth8, CV_8U);
+  cv::imwrite(dir + "/case/truth.png", truth8);
+  return dir + "/case";
+}
+
+TEST(PredictRoomsOfflineTool, WritesRoomsCompletedMapAndMetrics) {
+  const std::string dir = testing::makeTempDir("predict_tool");
+  const std::string input = syntheticCase(dir);
+  // Door 2 of this file lies far outside the map: reported, scored 0, door 1 still predicted.
+  std::ofstream(dir + "/doors.yaml") << "frame: map\ndoors:\n- {id: 1, position: [2.0, 4.0], width: 0.9, orientation: O}\n"
+                                        "- {id: 7, position: [90.0, 4.0], width: 0.9, orientation: O}\n";
+  std::ofstream(dir + "/params.yaml") << "start_search_radius: 1.5\nskewnormal_sigma: 3.0\n";
+  const auto result = runCommand(kPredict + " --map " + input + "/map.yaml --doors " + dir + "/doors.yaml" +
+                                 " --method unstructured --out " + dir + "/out --params " + dir + "/params.yaml" +
+                                 " --gt-rooms " + input + "/truth.png");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_NE(result.output.find("door 7 not placed: door position"), std::string::npos) << result.output;
+  const cv::Mat rooms = cv::imread(dir + "/out/rooms.png", cv::IMREAD_UNCHANGED);
+  EXPECT_GT(cv::countNonZero(rooms == 1), 1000);
+  EXPECT_EQ(cv::countNonZero(rooms == 2), 0);
+  const YAML::Node yaml = YAML::LoadFile(dir + "/out/rooms.yaml");
+  EXPECT_EQ(yaml["rooms"].size(), 2u);
+  EXPECT_TRUE(yaml["rooms"][0]["placed"].as<bool>());
+  EXPECT_FALSE(yaml["rooms"][1]["placed"].as<bool>());
+  EXPECT_GE(yaml["rooms"][0]["polygon"].size(), 3u);
+  const OccupancyGrid completed = loadMap(dir + "/out/map.yaml");
+  EXPECT_GT(cv::countNonZero(completed.cells == OccupancyGrid::kFree),
+            cv::countNonZero(loadMap(input + "/map.yaml").cells == OccupancyGrid::kFree));
+  const YAML::Node metrics = YAML::LoadFile(dir + "/out/metrics.yaml");
+  ASSERT_EQ(metrics["rooms"].size(), 2u);
+  EXPECT_GT(metrics["rooms"][0]["iou"].as<double>(), 0.9);
+  EXPECT_DOUBLE_EQ(metrics["rooms"][1]["iou"].as<double>(), 0.0);
+}
+
+TEST(PredictRoomsOfflineTool, ScoresABenchmarkCase) {
+  HIDDEN_ROOMS_REQUIRE_SHARED_DATA();
+  const std::string dir = testing::makeTempDir("predict_tool_benchmark");
+  const std::string input = testing::sharedDir() + "/data/closed_door_benchmark/Sabadell1/03_doors";
+  const auto result = runCommand(kPredict + " --map " + input + "/map.yaml --doors " + input + "/doors.yaml" +
+                                 " --method unstructured --out " + dir + " --gt-rooms " + input + "/gt_rooms.png" +
+                                 " --debug-dir " + dir + "/debug");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_NE(result.output.find("mean IoU"), std::string::npos);
+  EXPECT_GT(YAML::LoadFile(dir + "/metrics.yaml")["mean_iou"].as<double>(), 0.5);
+}
+
+TEST(PredictRoomsOfflineTool, BadInputGivesAClearErrorAndWritesNothing) {
+  const std::string dir = testing::makeTempDir("predict_tool_errors");
+  const std::string input = syntheticCase(dir);
+  const std::string base = kPredict + " --map " + input + "/map.yaml --doors " + input + "/doors.yaml --out " + dir + "/out";
+  std::ofstream(dir + "/typo.yaml") << "start_serach_radius: 2\n";
+  std::ofstream(dir + "/bad_doors.yaml") << "doors:\n- {id: 1, position: [.nan, 2], width: 1, orientation: O}\n";
+  cv::imwrite(dir + "/small_truth.png", cv::Mat1b::zeros(3, 3));
+  expectBadInput(base + " --method oracle", "unknown prediction method 'oracle'");
+  expectBadInput(base + " --method unstructured --params " + dir + "/typo.yaml", "unknown parameter 'start_serach_radius'");
+  expectBadInput(base + " --method unstructured --gt-rooms " + dir + "/small_truth.png", "true rooms image is 3x3");
+  expectBadInput(base + " --method unstructured --gt-rooms " + dir + "/absent.png", "cannot read");
+  expectBadInput(kPredict + " --map " + dir + "/absent.yaml --doors " + input + "/doors.yaml --out " + dir +
+                     "/out --method unstructured", "absent.yaml: cannot open map yaml");
+  expectBadInput(kPredict + " --map " + input + "/map.yaml --doors " + dir + "/bad_doors.yaml --out " + dir +
+                     "/out --method unstructured", "not finite");
+  expectBadInput(base, "--method");
+  EXPECT_FALSE(std::filesystem::exists(dir + "/out"));
+}
+
 TEST(Tools, HelpExitsZero) {
   EXPECT_EQ(runCommand(kRender + " --help").exit_code, 0);
   EXPECT_EQ(runCommand(kGenerate + " --help").exit_code, 0);
+  EXPECT_EQ(runCommand(kPredict + " --help").exit_code, 0);
 }
 
 }  // namespace

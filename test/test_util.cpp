@@ -1,5 +1,8 @@
 #include "test_util.h"
 
+#include "hidden_rooms/environment.h"
+#include "hidden_rooms/render.h"
+
 #include <sys/wait.h>
 
 #include <cstdio>
@@ -91,6 +94,17 @@ std::string corridorWithTwoRoomsXml(const std::string& door1_status, const std::
          "<real_distance><value>100</value><um>cm</um></real_distance></scale>"
          "<building_type><main_type>OFFICE</main_type></building_type><floor><spaces>" +
          corridor + room_a + room_b + "</spaces></floor></building>";
+}
+
+void syntheticHiddenRoomA(OccupancyGrid* map, DoorsFile* doors, cv::Mat1w* truth) {
+  const Environment environment = parseEnvironment(corridorWithTwoRoomsXml(), "synthetic");
+  RenderedEnvironment rendered = renderEnvironment(environment, {0});
+  const cv::Mat1b room_a = rendered.space_labels == 2;
+  rendered.map.cells.setTo(OccupancyGrid::kUnknown, room_a);
+  *map = rendered.map;
+  *doors = rendered.closed_doors;
+  *truth = cv::Mat1w::zeros(room_a.size());
+  truth->setTo(1, room_a);
 }
 
 }  // namespace hidden_rooms::testing

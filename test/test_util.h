@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/core.hpp>
 
+#include "hidden_rooms/doors_file.h"
 #include "hidden_rooms/occupancy_grid.h"
 
 namespace hidden_rooms::testing {
@@ -74,5 +75,9 @@ CommandResult runCommand(const std::string& command);
 // corridor (door 1 at (40, 40) into A, door 2 at (140, 40) into B). `extra_portal` adds a PORTAL segment at a
 // pixel position to room A (to build files with a door on no wall).
 std::string corridorWithTwoRoomsXml(const std::string& door1_status = "", const std::string& extra_portal = "");
+
+// That environment rendered with door 1 closed and room A's free cells unknown: the map a robot exploring the
+// corridor would build, its closed door, and the true room (label 1 on room A).
+void syntheticHiddenRoomA(OccupancyGrid* map, DoorsFile* doors, cv::Mat1w* truth);
 
 }  // namespace hidden_rooms::testing

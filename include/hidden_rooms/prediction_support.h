@@ -1,0 +1,41 @@
+#pragma once
+
+// Pieces shared by the prediction methods.
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "hidden_rooms/doors_file.h"
+#include "hidden_rooms/occupancy_grid.h"
+#include "hidden_rooms/room_predictor.h"
+
+namespace hidden_rooms {
+
+// Smallest rectangle holding every known (free or occupied) cell; empty when the map has none.
+cv::Rect knownBoundingBox(const OccupancyGrid& map);
+
+// The unknown cell nearest to `position` within `max_distance` metres (the first cell behind a closed door).
+// False when the position is outside the map or no unknown cell is that close; `problem` then says which.
+bool nearestUnknownCell(const OccupancyGrid& map, const Point2& position, double max_distance, cv::Point* cell,
+                        std::string* problem);
+
+// Fills polygon (outer contour of the largest blob, map frame) and area (m²) of a prediction from its mask,
+// and sets placed = true; an empty mask makes it not placed with `problem` "no room predicted".
+void finishPrediction(const OccupancyGrid& map, RoomPrediction* room);
+
+// Throws InputError when the map has no cells or no known cell.
+void checkUsableMap(const OccupancyGrid& map);
+
+// The input map completed with the predicted rooms (METHOD.md §5): each placed room's cells free, unknown
+// cells around it walled, and its door opened as a free rectangle of the door's width joining the room to the
+// explored side.
+OccupancyGrid insertRooms(const OccupancyGrid& map, const DoorsFile& doors, const std::vector<RoomPrediction>& rooms);
+
+// Label image of the map's size: k on the cells of the room predicted for the k-th door (1-based), 0 elsewhere;
+// 16-bit so that more than 255 doors fit.
+cv::Mat1w roomLabels(const OccupancyGrid& map, const std::vector<RoomPrediction>& rooms);
+
+}  // namespace hidden_rooms

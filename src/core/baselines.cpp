@@ -1,0 +1,131 @@
+#include "hidden_rooms/baselines.h"
+
+#include <chrono>
+#include <cmath>
+
+#include <opencv2/imgproc.hpp>
+
+#include "hidden_rooms/input_error.h"
+#include "hidden_rooms/prediction_support.h"
+
+namespace hidden_rooms {
+
+namespace {
+
+// Defaults (documented in config/prediction.yaml).
+constexpr double kDefaultStartSearchRadius = 1.0;  // m: how far behind the door the first unknown cell may be
+constexpr double kDefaultSkewSigma = 2.0;          // m: spread of the density
+constexpr double kDefaultSkewPerWidth = 2.0;       // 1/m: shape alpha = c * door width, along the door normal
+constexpr double kDefaultSkewThreshold = 0.5;      // density / peak density above which a cell is free
+
+double secondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// Runs `predict_one(door, start cell, room)` for every door that has unknown space behind it.
+template <typename PredictOne>
+PredictionResult predictEveryDoor(const PredictionRequest& request, double start_search_radius,
+                                  PredictOne predict_one) {
+  const auto start_time = std::chrono::steady_clock::now();
+  checkUsableMap(request.map);
+  PredictionResult result;
+  for (const MapDoor& door : request.doors.doors) {
+    RoomPrediction room;
+    room.door_id = door.id;
+    room.mask = cv::Mat1b::zeros(request.map.cells.size());
+    cv::Point start;
+    if (nearestUnknownCell(request.map, door.position, start_search_radius, &start, &room.problem))
+      predict_one(door, start, &room);
+    finishPrediction(request.map, &room);
+    result.rooms.push_back(std::move(room));
+  }
+  result.seconds = secondsSince(start_time);
+  return result;
+}
+
+// Unknown cells connected (4-neighbours) to `start` through unknown cells, restricted to `allowed`.
+cv::Mat1b connectedUnknown(const OccupancyGrid& map, const cv::Mat1b& allowed, cv::Point start) {
+  cv::Mat1b passable = (map.cells == OccupancyGrid::kUnknown) & allowed;
+  cv::Mat1b mask = cv::Mat1b::zeros(map.height() + 2, map.width() + 2);
+  if (passable(start) == 0) return cv::Mat1b::zeros(map.cells.size());
+  cv::floodFill(passable, mask, start, 255, nullptr, 0, 0, 4 | cv::FLOODFILL_MASK_ONLY | (255 << 8));
+  return mask(cv::Rect(1, 1, map.width(), map.height())).clone();
+}
+
+}  // namespace
+
+std::map<std::string, double> UnstructuredPredictor::defaultParameters() const {
+  return {{"start_search_radius", kDefaultStartSearchRadius}};
+}
+
+PredictionResult UnstructuredPredictor::predict(const PredictionRequest& request) const {
+  const double radius = resolveParameters(*this, request.parameters).at("start_search_radius");
+  checkUsableMap(request.map);
+  const cv::Rect box = knownBoundingBox(request.map);
+  return predictEveryDoor(request, radius, [&](const MapDoor&, cv::Point start, RoomPrediction* room) {
+    // Rays from the centre of the start cell, half a cell apart at the farthest corner of the box.
+    const cv::Point2d origin(start.x + 0.5, start.y + 0.5);
+    const double reach = std::hypot(std::max(origin.x - box.x, box.br().x - origin.x),
+                                    std::max(origin.y - box.y, box.br().y - origin.y));
+    const int rays = std::max(360, static_cast<int>(std::ceil(2.0 * CV_PI * reach / 0.5)));
+    for (int i = 0; i < rays; ++i) {
+      const double angle = 2.0 * CV_PI * i / rays;
+      const cv::Point2d step(0.5 * std::cos(angle), 0.5 * std::sin(angle));
+      for (cv::Point2d p = origin;; p += step) {
+        const cv::Point cell(static_cast<int>(std::floor(p.x)), static_cast<int>(std::floor(p.y)));
+        if (!box.contains(cell) || request.map.cells(cell) != OccupancyGrid::kUnknown) break;
+        room->mask(cell) = 255;
+      }
+    }
+    room->terms["rays"] = rays;
+  });
+}
+
+std::map<std::string, double> SkewNormalPredictor::defaultParameters() const {
+  return {{"start_search_radius", kDefaultStartSearchRadius},
+          {"skewnormal_sigma", kDefaultSkewSigma},
+          {"skewnormal_shape_per_width", kDefaultSkewPerWidth},
+          {"skewnormal_p_th", kDefaultSkewThreshold}};
+}
+
+PredictionResult SkewNormalPredictor::predict(const PredictionRequest& request) const {
+  const auto parameters = resolveParameters(*this, request.parameters);
+  const double radius = parameters.at("start_search_radius");
+  const double sigma = parameters.at("skewnormal_sigma");
+  const double shape_per_width = parameters.at("skewnormal_shape_per_width");
+  const double threshold = parameters.at("skewnormal_p_th");
+  if (sigma <= 0.0) throw InputError("parameters", "skewnormal_sigma must be positive");
+  if (threshold <= 0.0 || threshold >= 1.0) throw InputError("parameters", "skewnormal_p_th must be in (0, 1)");
+  const OccupancyGrid& map = request.map;
+
+  return predictEveryDoor(request, radius, [&](const MapDoor& door, cv::Point start, RoomPrediction* room) {
+    // Normal of the door line, pointing to the side of the start cell (the unknown side).
+    Point2 normal = door.orientation == DoorOrientation::kAlongX ? Point2(0, 1) : Point2(1, 0);
+    if ((map.cellCentre(start.x, start.y) - door.position).dot(normal) < 0) normal = -normal;
+    const Point2 along(normal.y(), -normal.x());
+    const double alpha = shape_per_width * door.width;
+    // Density 2 phi(u) Phi(alpha u_n / sigma) in the door frame; evaluated within 4 sigma.
+    auto density = [&](const Point2& p) {
+      const Point2 u = p - door.position;
+      const double n = u.dot(normal) / sigma, a = u.dot(along) / sigma;
+      return 2.0 * std::exp(-0.5 * (n * n + a * a)) * 0.5 * std::erfc(-alpha * n / std::sqrt(2.0));
+    };
+    const int half = static_cast<int>(std::ceil(4.0 * sigma / map.resolution));
+    int col = 0, row = 0;
+    map.cellOf(door.position, &col, &row);
+    const cv::Rect window = cv::Rect(col - half, row - half, 2 * half + 1, 2 * half + 1) &
+                            cv::Rect(0, 0, map.width(), map.height());
+    cv::Mat1f values = cv::Mat1f::zeros(map.cells.size());
+    double peak = 0.0;
+    for (int r = window.y; r < window.br().y; ++r)
+      for (int c = window.x; c < window.br().x; ++c) {
+        values(r, c) = static_cast<float>(density(map.cellCentre(c, r)));
+        peak = std::max(peak, static_cast<double>(values(r, c)));
+      }
+    const cv::Mat1b likely_free = values > threshold * peak;
+    room->mask = connectedUnknown(map, likely_free, start);
+    room->terms["alpha"] = alpha;
+  });
+}
+
+}  // namespace hidden_rooms

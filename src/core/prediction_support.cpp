@@ -1,0 +1,124 @@
+#include "hidden_rooms/prediction_support.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <opencv2/imgproc.hpp>
+
+#include "hidden_rooms/input_error.h"
+
+namespace hidden_rooms {
+
+cv::Rect knownBoundingBox(const OccupancyGrid& map) {
+  std::vector<cv::Point> known;
+  cv::findNonZero(map.cells != OccupancyGrid::kUnknown, known);
+  return known.empty() ? cv::Rect() : cv::boundingRect(known);
+}
+
+bool nearestUnknownCell(const OccupancyGrid& map, const Point2& position, double max_distance, cv::Point* cell,
+                        std::string* problem) {
+  int col = 0, row = 0;
+  if (!map.cellOf(position, &col, &row)) {
+    *problem = "door position (" + std::to_string(position.x()) + ", " + std::to_string(position.y()) +
+               ") is outside the map";
+    return false;
+  }
+  const int radius = static_cast<int>(std::ceil(max_distance / map.resolution));
+  double best = std::numeric_limits<double>::infinity();
+  for (int r = std::max(0, row - radius); r <= std::min(map.height() - 1, row + radius); ++r)
+    for (int c = std::max(0, col - radius); c <= std::min(map.width() - 1, col + radius); ++c) {
+      if (map.cells(r, c) != OccupancyGrid::kUnknown) continue;
+      const double distance = (map.cellCentre(c, r) - position).norm();
+      if (distance < best && distance <= max_distance) {
+        best = distance;
+        *cell = cv::Point(c, r);
+      }
+    }
+  if (!std::isfinite(best)) {
+    *problem = "no unknown space within " + std::to_string(max_distance) + " m of the door";
+    return false;
+  }
+  return true;
+}
+
+void finishPrediction(const OccupancyGrid& map, RoomPrediction* room) {
+  const int cells = room->mask.empty() ? 0 : cv::countNonZero(room->mask);
+  if (cells == 0) {
+    room->placed = false;
+    if (room->problem.empty()) room->problem = "no room predicted";
+    room->polygon.clear();
+    room->area = 0.0;
+    return;
+  }
+  room->placed = true;
+  room->problem.clear();
+  room->area = cells * map.resolution * map.resolution;
+  std::vector<std::vector<cv::Point>> contours;
+  cv::findContours(room->mask.clone(), contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_SIMPLE);
+  const auto largest = std::max_element(contours.begin(), contours.end(), [](const auto& a, const auto& b) {
+    return cv::contourArea(a) < cv::contourArea(b);
+  });
+  room->polygon.clear();
+  for (const cv::Point& p : *largest) room->polygon.push_back(map.cellCentre(p.x, p.y));
+}
+
+void checkUsableMap(const OccupancyGrid& map) {
+  if (map.empty()) throw InputError("map", "the map is empty");
+  if (cv::countNonZero(map.cells != OccupancyGrid::kUnknown) == 0)
+    throw InputError("map", "the map has no known cell");
+  if (!(map.resolution > 0.0) || !std::isfinite(map.resolution))
+    throw InputError("map", "resolution must be positive");
+}
+
+OccupancyGrid insertRooms(const OccupancyGrid& map, const DoorsFile& doors, const std::vector<RoomPrediction>& rooms) {
+  OccupancyGrid completed = map;
+  cv::Mat1b all_rooms = cv::Mat1b::zeros(map.cells.size());
+  for (const RoomPrediction& room : rooms)
+    if (room.placed) all_rooms |= room.mask;
+  completed.cells.setTo(OccupancyGrid::kFree, all_rooms);
+  // Walls: unknown cells touching a room.
+  cv::Mat1b around;
+  cv::dilate(all_rooms, around, cv::Mat1b::ones(3, 3));
+  completed.cells.setTo(OccupancyGrid::kOccupied, around & ~all_rooms & (map.cells == OccupancyGrid::kUnknown));
+
+  // Doors: a free rectangle of the door's width across the door line, from the explored side to the room.
+  const double max_depth = 1.0;  // metres on each side of the door line
+  for (size_t k = 0; k < rooms.size() && k < doors.doors.size(); ++k) {
+    if (!rooms[k].placed) continue;
+    const MapDoor& door = doors.doors[k];
+    const Point2 along = door.orientation == DoorOrientation::kAlongX ? Point2(1, 0) : Point2(0, 1);
+    const Point2 across(-along.y(), along.x());
+    const int half_width = static_cast<int>(std::floor(0.5 * door.width / map.resolution));
+    const int depth = static_cast<int>(std::ceil(max_depth / map.resolution));
+    for (int s = -half_width; s <= half_width; ++s) {
+      // Walk across the door line in both directions until free space (explored side or room) is reached.
+      for (int side : {1, -1}) {
+        std::vector<cv::Point> path;
+        bool reached = false;
+        for (int t = 0; t <= depth && !reached; ++t) {
+          int col = 0, row = 0;
+          const Point2 p = door.position + map.resolution * (s * along + side * t * across);
+          if (!completed.cellOf(p, &col, &row)) break;
+          if (t > 0 && completed.cells(row, col) == OccupancyGrid::kFree && map.cells(row, col) != OccupancyGrid::kOccupied) {
+            reached = true;
+            break;
+          }
+          path.emplace_back(col, row);
+        }
+        if (!reached) continue;
+        for (const cv::Point& cell : path) completed.cells(cell) = OccupancyGrid::kFree;
+      }
+    }
+  }
+  return completed;
+}
+
+cv::Mat1w roomLabels(const OccupancyGrid& map, const std::vector<RoomPrediction>& rooms) {
+  cv::Mat1w labels = cv::Mat1w::zeros(map.cells.size());
+  for (size_t k = 0; k < rooms.size(); ++k)
+    if (rooms[k].placed) labels.setTo(static_cast<uint16_t>(k + 1), rooms[k].mask);
+  return labels;
+}
+
+}  // namespace hidden_rooms

@@ -1,0 +1,86 @@
+#include "hidden_rooms/room_predictor.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <functional>
+
+#include "hidden_rooms/baselines.h"
+#include "hidden_rooms/input_error.h"
+
+namespace hidden_rooms {
+
+namespace {
+
+using Factory = std::function<std::unique_ptr<RoomPredictor>()>;
+
+const std::map<std::string, Factory>& registry() {
+  static const std::map<std::string, Factory> methods{
+      {"skewnormal", [] { return std::make_unique<SkewNormalPredictor>(); }},
+      {"unstructured", [] { return std::make_unique<UnstructuredPredictor>(); }},
+  };
+  return methods;
+}
+
+}  // namespace
+
+std::map<std::string, double> loadParameterFile(const std::string& path) {
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path);
+  } catch (const YAML::BadFile&) {
+    throw InputError(path, "cannot open parameters file");
+  } catch (const YAML::Exception& error) {
+    throw InputError(path, std::string("malformed YAML: ") + error.what());
+  }
+  std::map<std::string, double> parameters;
+  if (root.IsNull()) return parameters;
+  if (!root.IsMap()) throw InputError(path, "parameters file must be a mapping of names to numbers");
+  for (const auto& entry : root) {
+    const std::string name = entry.first.as<std::string>();
+    double value = 0.0;
+    try {
+      value = entry.second.as<double>();
+    } catch (const YAML::Exception&) {
+      throw InputError(path, "parameter '" + name + "' is not a number");
+    }
+    if (!std::isfinite(value)) throw InputError(path, "parameter '" + name + "' is not finite");
+    parameters[name] = value;
+  }
+  return parameters;
+}
+
+std::map<std::string, double> resolveParameters(const RoomPredictor& method,
+                                                const std::map<std::string, double>& overrides) {
+  std::map<std::string, double> parameters = method.defaultParameters();
+  for (const auto& [name, value] : overrides) {
+    if (!std::isfinite(value)) throw InputError("parameters", "parameter '" + name + "' is not finite");
+    if (parameters.count(name)) {
+      parameters[name] = value;
+      continue;
+    }
+    bool read_by_another = false;
+    for (const auto& [other_name, factory] : registry()) read_by_another |= factory()->defaultParameters().count(name) > 0;
+    if (!read_by_another)
+      throw InputError("parameters", "unknown parameter '" + name + "' (no prediction method reads it)");
+  }
+  return parameters;
+}
+
+std::vector<std::string> roomPredictorNames() {
+  std::vector<std::string> names;
+  for (const auto& [name, factory] : registry()) names.push_back(name);
+  return names;
+}
+
+std::unique_ptr<RoomPredictor> makeRoomPredictor(const std::string& name) {
+  const auto found = registry().find(name);
+  if (found == registry().end()) {
+    std::string known;
+    for (const std::string& method : roomPredictorNames()) known += (known.empty() ? "" : ", ") + method;
+    throw InputError("method", "unknown prediction method '" + name + "' (known: " + known + ")");
+  }
+  return found->second();
+}
+
+}  // namespace hidden_rooms
