@@ -26,7 +26,7 @@ PACKAGES=(
   libopencv-dev libeigen3-dev libtinyxml2-dev libyaml-cpp-dev libboost-program-options-dev
   # tests and scripts
   libgtest-dev googletest python3-nose python3-yaml python3-numpy python3-matplotlib python3-tqdm
-  python3-opencv xvfb
+  python3-opencv xvfb time
 )
 
 missing=()

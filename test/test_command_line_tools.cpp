@@ -46,6 +46,8 @@ TEST(RenderEnvironmentTool, WritesMapLabelsDoorsAndPreview) {
   EXPECT_FALSE(cv::imread(dir + "/out/preview.png").empty());
 }
 
+void expectBadInput(const std::string& command, const std::string& expected);
+
 TEST(RenderEnvironmentTool, RendersASharedEnvironmentWithAllDoorsClosed) {
   HIDDEN_ROOMS_REQUIRE_SHARED_DATA();
   const std::string dir = testing::makeTempDir("render_tool_shared");
@@ -53,6 +55,19 @@ TEST(RenderEnvironmentTool, RendersASharedEnvironmentWithAllDoorsClosed) {
                                  "/data/environments/school/Sabadell1.xml --out " + dir + " --closed all");
   ASSERT_EQ(result.exit_code, 0) << result.output;
   EXPECT_EQ(loadDoors(dir + "/doors.yaml").doors.size(), 17u);
+  // Hiding the rooms needs closable doors: Sabadell1 has 12 of its 17.
+  expectBadInput(kRender + " " + testing::sharedDir() + "/data/environments/school/Sabadell1.xml --out " + dir +
+                       "/hidden --closed all --hide-closed-rooms",
+                   "is not closable");
+  const auto hidden = runCommand(kRender + " " + testing::sharedDir() +
+                                 "/data/environments/school/Sabadell1.xml --out " + dir +
+                                 "/hidden --closed closable --hide-closed-rooms");
+  ASSERT_EQ(hidden.exit_code, 0) << hidden.output;
+  const cv::Mat truth = cv::imread(dir + "/hidden/true_rooms.png", cv::IMREAD_UNCHANGED);
+  double max_label = 0;
+  cv::minMaxLoc(truth, nullptr, &max_label);
+  EXPECT_EQ(max_label, 12.0);
+  EXPECT_EQ(loadDoors(dir + "/hidden/doors.yaml").doors.size(), 12u);
 }
 
 // Each bad input: exit code 2 and a message naming the input and the problem.

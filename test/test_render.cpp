@@ -158,6 +158,32 @@ TEST(Render, ClosedDoorsSealAndOpenDoorsJoinInSharedEnvironments) {
   EXPECT_GE(static_cast<double>(joined) / doors, 0.98);
 }
 
+TEST(Render, HiddenRoomsAreUnknownWithTheirUnseenWalls) {
+  const Environment environment = parseEnvironment(testing::corridorWithTwoRoomsXml(), "synthetic");
+  const RenderedEnvironment rendered = renderEnvironment(environment, {0});
+  const HiddenRoomsCase hidden = hideClosedRooms(environment, rendered);
+  const cv::Mat1b room_a = rendered.space_labels == 2;
+  EXPECT_EQ(cv::countNonZero(hidden.true_rooms == 1), cv::countNonZero(room_a));
+  EXPECT_EQ(cv::countNonZero((hidden.map.cells != OccupancyGrid::kUnknown) & room_a), 0);
+  int col = 0, row = 0;
+  // Room A's far wall (y = 0) is unseen; its wall to the corridor (y = 4) and to room B (x = 4) are seen.
+  ASSERT_TRUE(hidden.map.cellOf(Point2(2.0, 0.0), &col, &row));
+  EXPECT_EQ(hidden.map.cells(row, col), OccupancyGrid::kUnknown);
+  ASSERT_TRUE(hidden.map.cellOf(Point2(1.0, 4.0), &col, &row));
+  EXPECT_EQ(hidden.map.cells(row, col), OccupancyGrid::kOccupied);
+  ASSERT_TRUE(hidden.map.cellOf(Point2(4.0, 2.0), &col, &row));
+  EXPECT_EQ(hidden.map.cells(row, col), OccupancyGrid::kOccupied);
+  // Everything else is as rendered.
+  EXPECT_EQ(cv::countNonZero((hidden.map.cells != rendered.map.cells) & (rendered.space_labels == 3)), 0);
+  // A closed door with no room behind it alone (here: a door number that does not exist) is an error.
+  EXPECT_THROW(hideClosedRooms(environment, [&] {
+                 RenderedEnvironment wrong = rendered;
+                 wrong.closed_doors.doors[0].id = 99;
+                 return wrong;
+               }()),
+               InputError);
+}
+
 TEST(Render, LabelImagesAre8BitOr16Bit) {
   const std::string dir = testing::makeTempDir("labels");
   cv::Mat1w few = cv::Mat1w::zeros(4, 4), many = cv::Mat1w::zeros(4, 4);

@@ -100,8 +100,8 @@ void deriveDoors(Environment* environment, const std::string& source_name);
 std::string environmentToXml(const Environment& environment);
 void saveEnvironment(const Environment& environment, const std::string& path);
 
-// Door indices named by `spec`: "" = none, "all" = every door joining two spaces, else comma-separated door
-// numbers or portal ids. Throws InputError (naming `source_name`) for a door that does not exist.
+// Door indices named by `spec`: "" = none, "all" = every door joining two spaces, "closable" = the closable
+// doors, else comma-separated door numbers or portal ids. Throws InputError (naming `source_name`) for a door that does not exist.
 std::set<int> parseDoorSelection(const Environment& environment, const std::string& spec,
                                  const std::string& source_name);
 

@@ -38,4 +38,9 @@ OccupancyGrid insertRooms(const OccupancyGrid& map, const DoorsFile& doors, cons
 // 16-bit so that more than 255 doors fit.
 cv::Mat1w roomLabels(const OccupancyGrid& map, const std::vector<RoomPrediction>& rooms);
 
+// Picture for people: the map in grey, each predicted room tinted in its own colour and, when `true_labels` is
+// not empty (same labels), each true room outlined in green.
+cv::Mat3b renderPredictionOverlay(const OccupancyGrid& map, const cv::Mat1w& predicted_labels,
+                                  const cv::Mat& true_labels);
+
 }  // namespace hidden_rooms

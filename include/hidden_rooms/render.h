@@ -27,12 +27,24 @@ struct RenderedEnvironment {
   OccupancyGrid map;        // free inside spaces, walls occupied, unknown outside
   cv::Mat1w space_labels;   // per cell: 1 + index of the space whose free cells it belongs to, 0 elsewhere
   DoorsFile closed_doors;   // the closed doors, frame "map"
+  double wall_thickness = 0.0;  // metres, as drawn
 };
 
 // Renders the environment. Doors in `closed_door_indices`, doors whose status is CLOSED and exterior doors
 // (joining fewer than two spaces) are drawn as wall; every other door gets a gap of `door_width`.
 RenderedEnvironment renderEnvironment(const Environment& environment, const std::set<int>& closed_door_indices,
                                       const RenderOptions& options = RenderOptions());
+
+// What a robot maps when the closed doors stay shut: the rendering with the room behind each closed door made
+// unknown, its walls too except where they face explored free space. `true_rooms` holds k on the free cells
+// of the room behind the k-th closed door (the order of `closed_doors`). Throws InputError for a closed door
+// that is not closable (its room has other doors, so nothing would be hidden behind it).
+struct HiddenRoomsCase {
+  OccupancyGrid map;
+  DoorsFile closed_doors;
+  cv::Mat1w true_rooms;
+};
+HiddenRoomsCase hideClosedRooms(const Environment& environment, const RenderedEnvironment& rendered);
 
 // Colour preview for people: spaces tinted, walls black, open doors green, closed doors red with their
 // numbers.

@@ -542,6 +542,10 @@ int roomBehindDoor(const Environment& environment, int door_index) {
 std::set<int> parseDoorSelection(const Environment& environment, const std::string& spec,
                                  const std::string& source_name) {
   std::set<int> selected;
+  if (spec == "closable") {
+    for (int door : closableDoors(environment)) selected.insert(door);
+    return selected;
+  }
   if (spec == "all") {
     for (size_t d = 0; d < environment.doors.size(); ++d)
       if (environment.doors[d].space_indices.size() >= 2) selected.insert(static_cast<int>(d));

@@ -121,4 +121,33 @@ cv::Mat1w roomLabels(const OccupancyGrid& map, const std::vector<RoomPrediction>
   return labels;
 }
 
+cv::Mat3b renderPredictionOverlay(const OccupancyGrid& map, const cv::Mat1w& predicted_labels,
+                                  const cv::Mat& true_labels) {
+  cv::Mat3b overlay;
+  cv::cvtColor(map.toGreyImage(), overlay, cv::COLOR_GRAY2BGR);
+  double max_label = 0.0;
+  cv::minMaxLoc(predicted_labels, nullptr, &max_label);
+  for (int label = 1; label <= static_cast<int>(max_label); ++label) {
+    const cv::Mat1b room = predicted_labels == label;
+    if (cv::countNonZero(room) == 0) continue;
+    cv::Mat3b hsv(1, 1, cv::Vec3b(static_cast<uchar>(std::fmod(label * 137.508, 360.0) / 2), 170, 230)), bgr;
+    cv::cvtColor(hsv, bgr, cv::COLOR_HSV2BGR);
+    cv::Mat3b tinted;
+    cv::addWeighted(overlay, 0.4, cv::Mat3b(overlay.size(), bgr(0, 0)), 0.6, 0.0, tinted);
+    tinted.copyTo(overlay, room);
+  }
+  if (!true_labels.empty()) {
+    cv::Mat1i truth;
+    true_labels.convertTo(truth, CV_32S);
+    double max_truth = 0.0;
+    cv::minMaxLoc(truth, nullptr, &max_truth);
+    for (int label = 1; label <= static_cast<int>(max_truth); ++label) {
+      std::vector<std::vector<cv::Point>> contours;
+      cv::findContours(cv::Mat1b(truth == label), contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_SIMPLE);
+      cv::drawContours(overlay, contours, -1, cv::Scalar(0, 160, 0), 2);
+    }
+  }
+  return overlay;
+}
+
 }  // namespace hidden_rooms

@@ -77,6 +77,7 @@ RenderedEnvironment renderEnvironment(const Environment& environment, const std:
   const auto [low, high] = environment.bounds();
   const double resolution = options.resolution;
   RenderedEnvironment result;
+  result.wall_thickness = thickness;
   OccupancyGrid& grid = result.map;
   grid.resolution = resolution;
   grid.origin = ((low.array() - options.margin) / resolution).floor() * resolution;
@@ -164,6 +165,36 @@ RenderedEnvironment renderEnvironment(const Environment& environment, const std:
     result.closed_doors.doors.push_back(closed);
   }
   return result;
+}
+
+HiddenRoomsCase hideClosedRooms(const Environment& environment, const RenderedEnvironment& rendered) {
+  HiddenRoomsCase hidden;
+  hidden.map = rendered.map;
+  hidden.closed_doors = rendered.closed_doors;
+  hidden.true_rooms = cv::Mat1w::zeros(rendered.map.cells.size());
+  cv::Mat1b hidden_free = cv::Mat1b::zeros(rendered.map.cells.size());
+  for (size_t k = 0; k < rendered.closed_doors.doors.size(); ++k) {
+    const int door = environment.findDoor(std::to_string(rendered.closed_doors.doors[k].id));
+    const int room = door >= 0 ? roomBehindDoor(environment, door) : -1;
+    if (room < 0)
+      throw InputError("closed doors", "door " + std::to_string(rendered.closed_doors.doors[k].id) +
+                                           " is not closable: no room lies behind it alone");
+    const cv::Mat1b cells = rendered.space_labels == room + 1;
+    hidden.true_rooms.setTo(static_cast<uint16_t>(k + 1), cells);
+    hidden_free |= cells;
+  }
+  // Walls within reach of a hidden room and out of reach of every explored free cell are unseen too.
+  const cv::Mat1b visible_free = (rendered.map.cells == OccupancyGrid::kFree) & ~hidden_free;
+  const cv::Mat1b occupied = rendered.map.cells == OccupancyGrid::kOccupied;
+  cv::Mat1f to_visible, to_hidden;
+  cv::distanceTransform(~visible_free, to_visible, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+  cv::distanceTransform(~hidden_free, to_hidden, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+  // A wall cell is seen when it lies within the wall's full thickness of explored free space.
+  const double thickness_cells = rendered.wall_thickness / rendered.map.resolution + 1.0;
+  const cv::Mat1b near_visible = to_visible <= static_cast<float>(thickness_cells);
+  hidden.map.cells.setTo(OccupancyGrid::kUnknown, hidden_free);
+  hidden.map.cells.setTo(OccupancyGrid::kUnknown, occupied & ~near_visible & (to_hidden < to_visible));
+  return hidden;
 }
 
 cv::Mat3b renderPreview(const Environment& environment, const RenderedEnvironment& rendered) {

@@ -84,7 +84,8 @@ int run(int argc, char** argv) {
                         "       [--params FILE.yaml] [--gt-rooms LABELS.png] [--debug-dir D]\n"
                         "Methods: " + methods + "\n"
                         "Writes DIR/rooms.png (label k = room of the k-th door), DIR/rooms.yaml, DIR/map.yaml +\n"
-                        "DIR/map.pgm (the map completed with the rooms) and, with --gt-rooms, DIR/metrics.yaml.",
+                        "DIR/map.pgm (the map completed with the rooms), DIR/overlay.png (a picture: predicted rooms\n"
+                        "tinted, true rooms outlined in green) and, with --gt-rooms, DIR/metrics.yaml.",
                         options, po::positional_options_description(), &values))
     return kExitOk;
 
@@ -114,6 +115,9 @@ int run(int argc, char** argv) {
   saveLabelImage(labels, (out / "rooms.png").string());
   writeRoomsYaml(request, result, method, (out / "rooms.yaml").string());
   saveMap(insertRooms(request.map, request.doors, result.rooms), (out / "map").string());
+  const std::string overlay_path = (out / "overlay.png").string();
+  if (!cv::imwrite(overlay_path, renderPredictionOverlay(request.map, labels, truth)))
+    throw InputError(overlay_path, "cannot write overlay");
 
   std::cout << method << ": " << result.rooms.size() << " doors in " << std::fixed << std::setprecision(3)
             << result.seconds << " s -> " << out_dir << std::endl;

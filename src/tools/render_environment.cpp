@@ -2,6 +2,7 @@
 // environment as a map_server map, a label image of its spaces, its closed doors and a preview.
 #include <filesystem>
 #include <iostream>
+#include <optional>
 #include <set>
 
 #include <opencv2/imgcodecs.hpp>
@@ -21,11 +22,15 @@ int run(int argc, char** argv) {
   RenderOptions render_options;
   std::string environment_path, out_dir, closed_spec;
   double wall_thickness = 0.0;
+  bool hide_rooms = false;
   options.add_options()
       ("environment", po::value(&environment_path)->required(), "environment XML (thesis schema)")
       ("out", po::value(&out_dir)->required(), "output folder (created)")
       ("resolution", po::value(&render_options.resolution)->default_value(0.05), "metres per cell")
-      ("closed", po::value(&closed_spec), "doors drawn closed: comma-separated door numbers or ids, or 'all'")
+      ("closed", po::value(&closed_spec),
+       "doors drawn closed: comma-separated door numbers or ids, 'closable' or 'all'")
+      ("hide-closed-rooms", po::bool_switch(&hide_rooms),
+       "make the room behind each closed door unknown, as a robot would map it, and write DIR/true_rooms.png")
       ("door-width", po::value(&render_options.door_width)->default_value(0.9), "gap cut at open doors, metres")
       ("wall-thickness", po::value(&wall_thickness),
        "wall thickness, metres (default: the file's <wall_thickness>, else 0.15)")
@@ -34,9 +39,11 @@ int run(int argc, char** argv) {
   positional.add("environment", 1);
   po::variables_map values;
   if (!parseCommandLine(argc, argv,
-                        "Usage: render_environment ENV.xml --out DIR [--resolution R] [--closed ID,...|all]\n"
+                        "Usage: render_environment ENV.xml --out DIR [--resolution R] [--closed ID,...|closable|all]\n"
+                        "                          [--hide-closed-rooms]\n"
                         "Writes DIR/map.yaml, DIR/map.pgm, DIR/spaces.png (label = 1 + space index in XML order),\n"
-                        "DIR/doors.yaml (the closed doors, map frame) and DIR/preview.png.",
+                        "DIR/doors.yaml (the closed doors, map frame) and DIR/preview.png; with --hide-closed-rooms\n"
+                        "also DIR/true_rooms.png (label k = the room behind the k-th closed door).",
                         options, positional, &values))
     return kExitOk;
   if (values.count("wall-thickness")) render_options.wall_thickness = wall_thickness;
@@ -45,12 +52,16 @@ int run(int argc, char** argv) {
   const std::set<int> closed = parseDoorSelection(environment, closed_spec, "--closed");
   const RenderedEnvironment rendered = renderEnvironment(environment, closed, render_options);
 
+  std::optional<HiddenRoomsCase> hidden;
+  if (hide_rooms) hidden = hideClosedRooms(environment, rendered);
+
   createOutputDirectory(out_dir);
-  const std::string prefix = (std::filesystem::path(out_dir) / "map").string();
-  saveMap(rendered.map, prefix);
-  saveLabelImage(rendered.space_labels, (std::filesystem::path(out_dir) / "spaces.png").string());
-  saveDoors(rendered.closed_doors, (std::filesystem::path(out_dir) / "doors.yaml").string());
-  const std::string preview_path = (std::filesystem::path(out_dir) / "preview.png").string();
+  const std::filesystem::path out(out_dir);
+  saveMap(hidden ? hidden->map : rendered.map, (out / "map").string());
+  saveLabelImage(rendered.space_labels, (out / "spaces.png").string());
+  saveDoors(rendered.closed_doors, (out / "doors.yaml").string());
+  if (hidden) saveLabelImage(hidden->true_rooms, (out / "true_rooms.png").string());
+  const std::string preview_path = (out / "preview.png").string();
   if (!cv::imwrite(preview_path, renderPreview(environment, rendered)))
     throw InputError(preview_path, "cannot write preview");
 

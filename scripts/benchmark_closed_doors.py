@@ -1,0 +1,519 @@
+#!/usr/bin/python3
+"""Runs room-prediction methods on a closed-door benchmark folder and compares them with the reference.
+
+Usage: benchmark_closed_doors.py BENCH_DIR --method NAME [--methods A,B,...] [--jobs N] [--binary PATH]
+                                 [--keep DIR] [--params FILE.yaml] [--csv FILE] [--plot FILE.png]
+
+For every valid case of BENCH_DIR/cases.csv it runs `predict_rooms_offline` once per method (in parallel),
+times the whole command, reads the per-door IoU from the command's metrics.yaml and computes the thesis
+implementation's IoU from reference_rooms.png vs gt_rooms.png. It prints a table by number of closed doors,
+the overall mean IoU per method and of the reference, and the time and peak memory per method.
+
+Peak memory is the maximum resident set size of each command as measured by `/usr/bin/time -f %M` (GNU time),
+which wraps every run. resource.getrusage(RUSAGE_CHILDREN) is not used: on Linux a child started by this
+Python process inherits the parent's RSS high-water mark through fork/exec, so it would report the size of
+this script rather than of the command. Without /usr/bin/time the peak memory is not measured.
+
+Exit codes: 0 all cases ran, 1 some case failed (it is counted with IoU 0), 2 bad arguments or benchmark folder.
+"""
+import argparse
+import concurrent.futures
+import csv
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+
+import cv2
+import numpy as np
+import yaml
+from tqdm import tqdm
+
+BINARY_NAME = "predict_rooms_offline"
+GNU_TIME = "/usr/bin/time"
+PACKAGE_NAME = "hidden_rooms"
+REPO_DIR = os.path.dirname(os.path.dirname(os.path.realpath(__file__)))
+STDERR_EXCERPT_LINES = 8
+MAX_DOORS_ROW = 15
+MAX_FAILURES_LISTED = 20
+
+
+class BenchmarkError(Exception):
+    """A problem with the arguments or the benchmark folder (exit code 2)."""
+
+
+# --------------------------------------------------------------------------------------------------------
+# Benchmark folder
+
+
+class Case:
+    """One case of the benchmark: its folder, its doors and the reference score."""
+
+    def __init__(self, row, bench_dir):
+        self.env = row["env"]
+        self.name = row["case"]
+        self.folder = os.path.join(bench_dir, self.env, self.name)
+        self.csv_reference_iou = parse_optional_float(row.get("reference_iou"))
+        self.doors, self.doors_problem = read_door_count(os.path.join(self.folder, "doors.yaml"))
+        if self.doors is None:
+            self.doors = parse_optional_int(row.get("doors_found")) or parse_optional_int(
+                row.get("closed_doors_nominal")) or 0
+        self.reference_iou = None
+        self.reference_problem = None
+
+    @property
+    def label(self):
+        return "%s/%s" % (self.env, self.name)
+
+    def path(self, name):
+        return os.path.join(self.folder, name)
+
+
+def parse_optional_float(text):
+    """A float from a CSV cell, None when the cell is empty."""
+    text = (text or "").strip()
+    return float(text) if text else None
+
+
+def parse_optional_int(text):
+    """An int from a CSV cell, None when the cell is empty."""
+    value = parse_optional_float(text)
+    return None if value is None else int(value)
+
+
+def read_door_count(path):
+    """Number of doors in a doors.yaml, and None plus the problem when it cannot be read."""
+    try:
+        with open(path) as stream:
+            data = yaml.safe_load(stream)
+        return len(data["doors"]), None
+    except (OSError, yaml.YAMLError, TypeError, KeyError) as error:
+        return None, "%s: %s" % (path, error)
+
+
+def load_cases(bench_dir):
+    """The valid cases listed in BENCH_DIR/cases.csv."""
+    csv_path = os.path.join(bench_dir, "cases.csv")
+    if not os.path.isdir(bench_dir):
+        raise BenchmarkError("benchmark folder %s does not exist" % bench_dir)
+    if not os.path.isfile(csv_path):
+        raise BenchmarkError("%s is not a closed-door benchmark folder: %s is missing" % (bench_dir, csv_path))
+    with open(csv_path, newline="") as stream:
+        reader = csv.DictReader(stream)
+        missing = {"env", "case", "valid"} - set(reader.fieldnames or [])
+        if missing:
+            raise BenchmarkError("%s lacks the column(s) %s" % (csv_path, ", ".join(sorted(missing))))
+        rows = list(reader)
+    cases = [Case(row, bench_dir) for row in rows if (row.get("valid") or "").strip() == "1"]
+    if not cases:
+        raise BenchmarkError("%s lists no valid case" % csv_path)
+    return cases
+
+
+# --------------------------------------------------------------------------------------------------------
+# Reference score
+
+
+def read_label_image(path):
+    """A label image as a 2-D integer array; raises ValueError when it cannot be read."""
+    if not os.path.isfile(path):
+        raise ValueError("%s is missing" % path)
+    image = cv2.imread(path, cv2.IMREAD_UNCHANGED)
+    if image is None:
+        raise ValueError("%s cannot be read" % path)
+    if image.ndim != 2:
+        raise ValueError("%s is not a single-channel label image" % path)
+    return image
+
+
+def door_ious(predicted, truth, doors):
+    """IoU of label k in both images for k = 1..doors (0 when both are empty)."""
+    ious = []
+    for label in range(1, doors + 1):
+        predicted_room = predicted == label
+        true_room = truth == label
+        union = np.count_nonzero(predicted_room | true_room)
+        intersection = np.count_nonzero(predicted_room & true_room)
+        ious.append(intersection / union if union else 0.0)
+    return ious
+
+
+def score_reference(case):
+    """Sets case.reference_iou (mean IoU of reference_rooms.png), or case.reference_problem."""
+    try:
+        truth = read_label_image(case.path("gt_rooms.png"))
+        reference = read_label_image(case.path("reference_rooms.png"))
+        if reference.shape != truth.shape:
+            raise ValueError("reference_rooms.png is %dx%d, gt_rooms.png %dx%d" % (
+                reference.shape[1], reference.shape[0], truth.shape[1], truth.shape[0]))
+        if case.doors <= 0:
+            raise ValueError("no doors")
+        case.reference_iou = float(np.mean(door_ious(reference, truth, case.doors)))
+    except ValueError as error:
+        case.reference_problem = str(error)
+
+
+# --------------------------------------------------------------------------------------------------------
+# Running the offline command
+
+
+def find_binary(explicit=None):
+    """Path of predict_rooms_offline: --binary, else $CMAKE_PREFIX_PATH's lib/hidden_rooms, else the repo's .ws."""
+    if explicit:
+        if not (os.path.isfile(explicit) and os.access(explicit, os.X_OK)):
+            raise BenchmarkError("--binary %s is not an executable file" % explicit)
+        return explicit
+    candidates = []
+    for prefix in os.environ.get("CMAKE_PREFIX_PATH", "").split(os.pathsep):
+        if prefix:
+            candidates.append(os.path.join(prefix, "lib", PACKAGE_NAME, BINARY_NAME))
+    candidates.append(os.path.join(REPO_DIR, ".ws", "devel", "lib", PACKAGE_NAME, BINARY_NAME))
+    for candidate in candidates:
+        if os.path.isfile(candidate) and os.access(candidate, os.X_OK):
+            return candidate
+    raise BenchmarkError("%s not found; looked in:\n  %s\nBuild the workspace and `source .ws/devel/setup.bash`, "
+                         "or pass --binary PATH" % (BINARY_NAME, "\n  ".join(candidates)))
+
+
+def known_methods(binary):
+    """Method names listed by `binary --help` ("Methods: a, b"), or None when they cannot be told."""
+    try:
+        result = subprocess.run([binary, "--help"], capture_output=True, text=True, timeout=60)
+    except (OSError, subprocess.SubprocessError):
+        return None
+    for line in (result.stdout + result.stderr).splitlines():
+        if line.strip().startswith("Methods:"):
+            return [name.strip() for name in line.split(":", 1)[1].split(",") if name.strip()]
+    return None
+
+
+class Run:
+    """The outcome of one method on one case."""
+
+    def __init__(self, case, method):
+        self.case = case
+        self.method = method
+        self.mean_iou = 0.0
+        self.iou_total = 0.0
+        self.door_ious = []
+        self.seconds = None
+        self.max_rss_kb = None
+        self.problem = None  # None when the run succeeded
+
+    @property
+    def failed(self):
+        return self.problem is not None
+
+
+def tail(path, lines):
+    """The last lines of a text file (empty when unreadable)."""
+    try:
+        with open(path, errors="replace") as stream:
+            return "".join(stream.readlines()[-lines:]).rstrip()
+    except OSError:
+        return ""
+
+
+def run_command(command, log_dir, timeout):
+    """Runs command with its output in log_dir; returns (exit code, wall seconds, max RSS kB or None, timed out).
+
+    The command runs under GNU time (when present) for its peak memory, in its own process group so that a
+    timeout kills the command and not only the wrapper.
+    """
+    memory_path = os.path.join(log_dir, "time.txt")
+    measure_memory = os.access(GNU_TIME, os.X_OK)
+    if measure_memory:
+        command = [GNU_TIME, "-f", "%M", "-o", memory_path] + command
+    with open(os.path.join(log_dir, "stdout.txt"), "w") as out, open(os.path.join(log_dir, "stderr.txt"), "w") as err:
+        start = time.monotonic()
+        process = subprocess.Popen(command, stdout=out, stderr=err, stdin=subprocess.DEVNULL, start_new_session=True)
+        timed_out = False
+        try:
+            code = process.wait(timeout=timeout if timeout and timeout > 0 else None)
+        except subprocess.TimeoutExpired:
+            timed_out = True
+            os.killpg(process.pid, signal.SIGKILL)
+            code = process.wait()
+        seconds = time.monotonic() - start
+    return code, seconds, read_max_rss(memory_path) if measure_memory else None, timed_out
+
+
+def read_max_rss(path):
+    """The %M value (kB) GNU time wrote last in path, None when absent."""
+    try:
+        with open(path) as stream:
+            lines = [line.strip() for line in stream if line.strip()]
+        return int(lines[-1]) if lines else None
+    except (OSError, ValueError):
+        return None
+
+
+def run_case(binary, case, method, out_root, params, timeout):
+    """Runs the offline command for one case and method and reads its metrics."""
+    run = Run(case, method)
+    out_dir = os.path.join(out_root, method, case.env, case.name)
+    log_dir = out_dir + ".log"
+    shutil.rmtree(out_dir, ignore_errors=True)
+    os.makedirs(log_dir, exist_ok=True)
+    command = [binary, "--map", case.path("map.yaml"), "--doors", case.path("doors.yaml"), "--method", method,
+               "--out", out_dir, "--gt-rooms", case.path("gt_rooms.png")]
+    if params:
+        command += ["--params", params]
+    try:
+        code, run.seconds, run.max_rss_kb, timed_out = run_command(command, log_dir, timeout)
+    except OSError as error:
+        run.problem = "cannot run %s: %s" % (binary, error)
+        return run
+    if timed_out or code != 0:
+        reason = "timed out after %g s" % timeout if timed_out else "exit code %d" % code
+        excerpt = tail(os.path.join(log_dir, "stderr.txt"), STDERR_EXCERPT_LINES) or tail(
+            os.path.join(log_dir, "stdout.txt"), STDERR_EXCERPT_LINES)
+        run.problem = reason + (":\n" + excerpt if excerpt else "")
+        return run
+    metrics_path = os.path.join(out_dir, "metrics.yaml")
+    try:
+        with open(metrics_path) as stream:
+            metrics = yaml.safe_load(stream)
+        run.mean_iou = float(metrics["mean_iou"])
+        run.iou_total = float(metrics["iou_total"])
+        run.door_ious = [float(room["iou"]) for room in metrics.get("rooms") or []]
+    except (OSError, yaml.YAMLError, TypeError, KeyError, ValueError) as error:
+        run.mean_iou = run.iou_total = 0.0
+        run.problem = "cannot read %s: %s" % (metrics_path, error)
+    return run
+
+
+def run_all(binary, cases, methods, out_root, params, jobs, timeout):
+    """Runs every method on every case in parallel, with a progress bar; returns {method: [Run]} in case order."""
+    tasks = [(case, method) for method in methods for case in cases]
+    results = {}
+    with concurrent.futures.ThreadPoolExecutor(max_workers=jobs) as pool:
+        futures = {pool.submit(run_case, binary, case, method, out_root, params, timeout): (case, method)
+                   for case, method in tasks}
+        with tqdm(total=len(futures), unit="run", desc="cases", file=sys.stderr) as progress:
+            for future in concurrent.futures.as_completed(futures):
+                case, method = futures[future]
+                results[(case.label, method)] = future.result()
+                progress.update(1)
+    return {method: [results[(case.label, method)] for case in cases] for method in methods}
+
+
+# --------------------------------------------------------------------------------------------------------
+# Report
+
+
+def mean_or_none(values):
+    """Mean of the values that are not None, None when there are none."""
+    values = [value for value in values if value is not None]
+    return float(np.mean(values)) if values else None
+
+
+def format_score(value, width=8):
+    return ("%.4f" % value if value is not None else "-").rjust(width)
+
+
+def print_table(cases, methods, runs):
+    """Mean IoU by number of closed doors: one row per number, one column per method plus the reference."""
+    width = max(12, *(len(method) + 1 for method in methods))
+    header = "doors  cases" + "".join(method.rjust(width) for method in methods) + \
+        "reference".rjust(width) + "ref cases".rjust(10)
+    print("Mean IoU by number of closed doors")
+    print(header)
+    print("-" * len(header))
+    counts = sorted({case.doors for case in cases} | set(range(1, MAX_DOORS_ROW + 1)))
+    for doors in counts:
+        indices = [i for i, case in enumerate(cases) if case.doors == doors]
+        line = "%5d  %5d" % (doors, len(indices))
+        for method in methods:
+            line += format_score(mean_or_none([runs[method][i].mean_iou for i in indices]), width)
+        references = [cases[i].reference_iou for i in indices if cases[i].reference_iou is not None]
+        line += format_score(mean_or_none(references), width) + ("%10d" % len(references))
+        print(line)
+    print()
+
+
+def print_overall(cases, methods, runs):
+    """Overall mean IoU per method and of the reference, and the agreement with cases.csv."""
+    with_reference = [i for i, case in enumerate(cases) if case.reference_iou is not None]
+    print("Overall (%d valid cases, %d with a reference prediction)" % (len(cases), len(with_reference)))
+    name_width = max(len("reference"), *(len(method) for method in methods))
+    for method in methods:
+        method_runs = runs[method]
+        print("  %s  mean IoU %.4f over %d cases (%.4f over the %d with a reference), mean IoU_tot %.4f" % (
+            method.ljust(name_width), np.mean([run.mean_iou for run in method_runs]), len(method_runs),
+            np.mean([method_runs[i].mean_iou for i in with_reference]) if with_reference else float("nan"),
+            len(with_reference), np.mean([run.iou_total for run in method_runs])))
+    reference = mean_or_none(cases[i].reference_iou for i in with_reference)
+    print("  %s  mean IoU %s over %d cases" % ("reference".ljust(name_width), format_score(reference, 0),
+                                              len(with_reference)))
+    differences = [abs(case.reference_iou - case.csv_reference_iou) for case in cases
+                   if case.reference_iou is not None and case.csv_reference_iou is not None]
+    if differences:
+        print("  reference vs cases.csv reference_iou: max difference %.4f over %d cases" % (
+            max(differences), len(differences)))
+    for case in cases:
+        if case.reference_iou is None:
+            print("  no reference score for %s: %s" % (case.label, case.reference_problem))
+    print()
+
+
+def print_resources(methods, runs):
+    """Median and p95 wall seconds per case, and peak memory, per method."""
+    print("Time per case (wall time of the whole command, successful runs) and peak memory (max RSS, /usr/bin/time)")
+    name_width = max(len("method"), *(len(method) for method in methods))
+    print("  %s  %6s  %9s  %9s  %12s" % ("method".ljust(name_width), "runs", "median s", "p95 s", "peak RSS MB"))
+    for method in methods:
+        seconds = [run.seconds for run in runs[method] if not run.failed and run.seconds is not None]
+        rss = [run.max_rss_kb for run in runs[method] if not run.failed and run.max_rss_kb is not None]
+        median = "%9.3f" % np.median(seconds) if seconds else "%9s" % "-"
+        p95 = "%9.3f" % np.percentile(seconds, 95) if seconds else "%9s" % "-"
+        peak = "%12.1f" % (max(rss) / 1024.0) if rss else "%12s" % "-"
+        print("  %s  %6d  %s  %s  %s" % (method.ljust(name_width), len(seconds), median, p95, peak))
+    if not os.access(GNU_TIME, os.X_OK):
+        print("  (peak memory not measured: %s is missing)" % GNU_TIME)
+    print()
+
+
+def print_failures(methods, runs):
+    """Every failed run with its stderr excerpt; returns the number of failures."""
+    failures = [run for method in methods for run in runs[method] if run.failed]
+    if failures:
+        print("%d failed run(s), counted with IoU 0:" % len(failures))
+        for run in failures[:MAX_FAILURES_LISTED]:
+            print("  %s %s: %s" % (run.method, run.case.label, run.problem.replace("\n", "\n      ")))
+        if len(failures) > MAX_FAILURES_LISTED:
+            print("  ... and %d more (the CSV's status column lists them all)" % (len(failures) - MAX_FAILURES_LISTED))
+        print()
+    return len(failures)
+
+
+def write_csv(path, cases, methods, runs):
+    """Per-case rows: env, case, doors, method, mean_iou, iou_total, seconds, reference_iou, status, max_rss_mb."""
+    with open(path, "w", newline="") as stream:
+        writer = csv.writer(stream)
+        writer.writerow(["env", "case", "doors", "method", "mean_iou", "iou_total", "seconds", "reference_iou",
+                         "status", "max_rss_mb"])
+        for method in methods:
+            for case, run in zip(cases, runs[method]):
+                writer.writerow([case.env, case.name, case.doors, method, "%.6f" % run.mean_iou,
+                                 "%.6f" % run.iou_total, "" if run.seconds is None else "%.4f" % run.seconds,
+                                 "" if case.reference_iou is None else "%.6f" % case.reference_iou,
+                                 "failed" if run.failed else "ok",
+                                 "" if run.max_rss_kb is None else "%.1f" % (run.max_rss_kb / 1024.0)])
+
+
+def write_plot(path, cases, methods, runs):
+    """Mean IoU vs number of closed doors per method and for the reference."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    counts = sorted({case.doors for case in cases})
+    figure, axes = plt.subplots(figsize=(8, 4.5))
+    series = [(method, [runs[method][i].mean_iou for i in range(len(cases))]) for method in methods]
+    series.append(("reference", [case.reference_iou for case in cases]))
+    for name, scores in series:
+        xs, ys = [], []
+        for doors in counts:
+            value = mean_or_none(score for case, score in zip(cases, scores) if case.doors == doors)
+            if value is not None:
+                xs.append(doors)
+                ys.append(value)
+        axes.plot(xs, ys, marker="o", linestyle="--" if name == "reference" else "-", label=name)
+    axes.set_xlabel("closed doors")
+    axes.set_ylabel("mean IoU")
+    axes.set_ylim(0, 1)
+    axes.set_xticks(counts)
+    axes.grid(True, alpha=0.3)
+    axes.legend()
+    figure.tight_layout()
+    figure.savefig(path, dpi=120)
+    plt.close(figure)
+
+
+# --------------------------------------------------------------------------------------------------------
+
+
+def parse_arguments(argv):
+    parser = argparse.ArgumentParser(
+        description="Benchmark room-prediction methods on a closed-door benchmark folder.")
+    parser.add_argument("bench_dir", metavar="BENCH_DIR", help="benchmark folder with cases.csv")
+    parser.add_argument("--method", action="append", default=[], help="a prediction method (repeatable)")
+    parser.add_argument("--methods", default="", help="comma-separated methods, printed side by side")
+    parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="parallel runs (default: cores)")
+    parser.add_argument("--binary", help="path of predict_rooms_offline (default: look in the workspace)")
+    parser.add_argument("--keep", metavar="DIR", help="keep the outputs of every run in DIR")
+    parser.add_argument("--params", metavar="FILE.yaml", help="parameter overrides passed to every run")
+    parser.add_argument("--csv", metavar="FILE", help="write the per-case rows to FILE")
+    parser.add_argument("--plot", metavar="FILE.png", help="plot mean IoU vs closed doors to FILE.png")
+    parser.add_argument("--timeout", type=float, default=600.0,
+                        help="seconds before a run is killed and counted as failed (default 600, 0 = none)")
+    args = parser.parse_args(argv)
+    methods = []
+    for name in args.method + args.methods.split(","):
+        name = name.strip()
+        if name and name not in methods:
+            methods.append(name)
+    if not methods:
+        parser.error("give at least one method with --method NAME or --methods A,B")
+    if args.jobs < 1:
+        parser.error("--jobs must be at least 1")
+    if args.params and not os.path.isfile(args.params):
+        parser.error("--params %s does not exist" % args.params)
+    args.method_list = methods
+    return args
+
+
+def main(argv=None):
+    args = parse_arguments(argv)
+    try:
+        cases = load_cases(args.bench_dir)
+        binary = find_binary(args.binary)
+        available = known_methods(binary)
+        unknown = [method for method in args.method_list if available is not None and method not in available]
+        if unknown:
+            raise BenchmarkError("unknown method(s) %s; %s knows: %s" % (
+                ", ".join(unknown), BINARY_NAME, ", ".join(available)))
+    except BenchmarkError as error:
+        print("benchmark_closed_doors.py: error: %s" % error, file=sys.stderr)
+        return 2
+
+    for case in cases:
+        score_reference(case)
+    print("%s: %d valid cases, methods %s, %d jobs, binary %s" % (
+        args.bench_dir, len(cases), ", ".join(args.method_list), args.jobs, binary))
+    sys.stdout.flush()
+
+    if args.keep:
+        os.makedirs(args.keep, exist_ok=True)
+        out_root = args.keep
+    else:
+        out_root = tempfile.mkdtemp(prefix="benchmark_closed_doors_")
+    params = os.path.abspath(args.params) if args.params else None
+    try:
+        runs = run_all(binary, cases, args.method_list, out_root, params, args.jobs, args.timeout)
+    finally:
+        if not args.keep:
+            shutil.rmtree(out_root, ignore_errors=True)
+
+    print()
+    print_table(cases, args.method_list, runs)
+    print_overall(cases, args.method_list, runs)
+    print_resources(args.method_list, runs)
+    failures = print_failures(args.method_list, runs)
+    if args.csv:
+        write_csv(args.csv, cases, args.method_list, runs)
+        print("per-case rows written to %s" % args.csv)
+    if args.plot:
+        write_plot(args.plot, cases, args.method_list, runs)
+        print("plot written to %s" % args.plot)
+    if args.keep:
+        print("run outputs kept in %s" % args.keep)
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
