@@ -35,8 +35,8 @@ void checkUsableMap(const OccupancyGrid& map);
 OccupancyGrid insertRooms(const OccupancyGrid& map, const DoorsFile& doors, const std::vector<RoomPrediction>& rooms);
 
 // Label image of the map's size: k on the cells of the room predicted for the k-th door (1-based), 0 elsewhere;
-// 16-bit so that more than 255 doors fit.
-cv::Mat1w roomLabels(const OccupancyGrid& map, const std::vector<RoomPrediction>& rooms);
+// 16-bit so that more than 255 doors fit. A cell claimed by several rooms goes to the one whose door is nearest.
+cv::Mat1w roomLabels(const OccupancyGrid& map, const DoorsFile& doors, const std::vector<RoomPrediction>& rooms);
 
 // Picture for people: the map in grey, each predicted room tinted in its own colour and, when `true_labels` is
 // not empty (same labels), each true room outlined in green.

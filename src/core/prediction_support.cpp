@@ -114,10 +114,21 @@ OccupancyGrid insertRooms(const OccupancyGrid& map, const DoorsFile& doors, cons
   return completed;
 }
 
-cv::Mat1w roomLabels(const OccupancyGrid& map, const std::vector<RoomPrediction>& rooms) {
+cv::Mat1w roomLabels(const OccupancyGrid& map, const DoorsFile& doors, const std::vector<RoomPrediction>& rooms) {
   cv::Mat1w labels = cv::Mat1w::zeros(map.cells.size());
-  for (size_t k = 0; k < rooms.size(); ++k)
-    if (rooms[k].placed) labels.setTo(static_cast<uint16_t>(k + 1), rooms[k].mask);
+  cv::Mat1f door_distance(map.cells.size(), std::numeric_limits<float>::infinity());
+  for (size_t k = 0; k < rooms.size() && k < doors.doors.size(); ++k) {
+    if (!rooms[k].placed) continue;
+    std::vector<cv::Point> cells;
+    cv::findNonZero(rooms[k].mask, cells);
+    for (const cv::Point& cell : cells) {
+      const float distance = static_cast<float>((map.cellCentre(cell.x, cell.y) - doors.doors[k].position).norm());
+      if (distance < door_distance(cell)) {
+        door_distance(cell) = distance;
+        labels(cell) = static_cast<uint16_t>(k + 1);
+      }
+    }
+  }
   return labels;
 }
 

@@ -7,6 +7,7 @@
 
 #include "hidden_rooms/baselines.h"
 #include "hidden_rooms/input_error.h"
+#include "hidden_rooms/structured_predictor.h"
 
 namespace hidden_rooms {
 
@@ -17,6 +18,7 @@ using Factory = std::function<std::unique_ptr<RoomPredictor>()>;
 const std::map<std::string, Factory>& registry() {
   static const std::map<std::string, Factory> methods{
       {"skewnormal", [] { return std::make_unique<SkewNormalPredictor>(); }},
+      {"structured", [] { return std::make_unique<StructuredPredictor>(); }},
       {"unstructured", [] { return std::make_unique<UnstructuredPredictor>(); }},
   };
   return methods;

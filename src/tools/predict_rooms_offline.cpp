@@ -111,7 +111,7 @@ int run(int argc, char** argv) {
 
   createOutputDirectory(out_dir);
   const std::filesystem::path out(out_dir);
-  const cv::Mat1w labels = roomLabels(request.map, result.rooms);
+  const cv::Mat1w labels = roomLabels(request.map, request.doors, result.rooms);
   saveLabelImage(labels, (out / "rooms.png").string());
   writeRoomsYaml(request, result, method, (out / "rooms.yaml").string());
   saveMap(insertRooms(request.map, request.doors, result.rooms), (out / "map").string());
