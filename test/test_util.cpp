@@ -1,7 +1,15 @@
 #include "test_util.h"
 
+#include <fstream>
+#include <sstream>
+
+#include <opencv2/imgcodecs.hpp>
+
 #include "hidden_rooms/environment.h"
+#include "hidden_rooms/evaluation.h"
+#include "hidden_rooms/prediction_support.h"
 #include "hidden_rooms/render.h"
+#include "hidden_rooms/room_predictor.h"
 
 #include <sys/wait.h>
 
@@ -105,6 +113,34 @@ void syntheticHiddenRoomA(OccupancyGrid* map, DoorsFile* doors, cv::Mat1w* truth
   *doors = rendered.closed_doors;
   *truth = cv::Mat1w::zeros(room_a.size());
   truth->setTo(1, room_a);
+}
+
+double benchmarkMeanIou(const std::string& method, int* cases) {
+  const std::string root = sharedDir() + "/data/closed_door_benchmark";
+  std::ifstream csv(root + "/cases.csv");
+  std::string line;
+  std::getline(csv, line);  // header: env,case,closed_doors_nominal,doors_found,valid,...
+  double total = 0.0;
+  int scored = 0;
+  const auto predictor = makeRoomPredictor(method);
+  while (std::getline(csv, line)) {
+    std::vector<std::string> fields;
+    std::stringstream row(line);
+    for (std::string field; std::getline(row, field, ',');) fields.push_back(field);
+    if (fields.size() < 5 || fields[4] != "1") continue;
+    const std::string dir = root + "/" + fields[0] + "/" + fields[1];
+    PredictionRequest request;
+    request.map = loadMap(dir + "/map.yaml");
+    request.doors = loadDoors(dir + "/doors.yaml");
+    const PredictionResult result = predictor->predict(request);
+    const cv::Mat truth = cv::imread(dir + "/gt_rooms.png", cv::IMREAD_UNCHANGED);
+    total += scoreRooms(roomLabels(request.map, request.doors, result.rooms), truth,
+                        static_cast<int>(request.doors.doors.size()))
+                 .mean_iou;
+    ++scored;
+  }
+  if (cases != nullptr) *cases = scored;
+  return scored > 0 ? total / scored : 0.0;
 }
 
 }  // namespace hidden_rooms::testing

@@ -80,4 +80,9 @@ std::string corridorWithTwoRoomsXml(const std::string& door1_status = "", const 
 // corridor would build, its closed door, and the true room (label 1 on room A).
 void syntheticHiddenRoomA(OccupancyGrid* map, DoorsFile* doors, cv::Mat1w* truth);
 
+// Mean IoU of a prediction method over the valid cases of the shared closed-door benchmark, scored as
+// scripts/benchmark_closed_doors.py does (rooms.png labels, mean over each case's doors, then over cases).
+// Counts the cases in `cases` when given.
+double benchmarkMeanIou(const std::string& method, int* cases = nullptr);
+
 }  // namespace hidden_rooms::testing

@@ -6,8 +6,10 @@
 #include <functional>
 
 #include "hidden_rooms/baselines.h"
+#include "hidden_rooms/default_predictor.h"
 #include "hidden_rooms/input_error.h"
 #include "hidden_rooms/structured_predictor.h"
+#include "hidden_rooms/thesis_predictor.h"
 
 namespace hidden_rooms {
 
@@ -17,8 +19,10 @@ using Factory = std::function<std::unique_ptr<RoomPredictor>()>;
 
 const std::map<std::string, Factory>& registry() {
   static const std::map<std::string, Factory> methods{
+      {"default", [] { return std::make_unique<DefaultPredictor>(); }},
       {"skewnormal", [] { return std::make_unique<SkewNormalPredictor>(); }},
       {"structured", [] { return std::make_unique<StructuredPredictor>(); }},
+      {"thesis", [] { return std::make_unique<ThesisPredictor>(); }},
       {"unstructured", [] { return std::make_unique<UnstructuredPredictor>(); }},
   };
   return methods;

@@ -1,0 +1,45 @@
+#pragma once
+
+// The project's own prediction method, "default": one rectangle per closed door, fitted to the walls the robot
+// saw around the door.
+//
+// 1. Orientation: the dominant wall direction (modulo 90 degrees) from the gradient directions of the occupied
+//    pixels; the map and its doors are rotated so that the walls run along x and y, and the rooms are rotated
+//    back at the end.
+// 2. Per door, in the door's frame (u along the door's wall, v into the unknown side):
+//    - the wall: the occupied pixels across the door; the room starts at the first unknown row behind it;
+//    - lateral extent: along the wall from the door in both directions while the wall continues (gaps up to
+//      default_wall_gap, e.g. open doorways) and the space just behind it is still unknown (a known pixel
+//      there is a perpendicular wall of an explored room);
+//    - doors on the same wall and the same side split their shared extent at the midpoint between them;
+//    - depth: per column of the extent, the unknown run behind the wall up to the first known pixel; the
+//      median when enough columns end on a known pixel inside the known map's bounding box, else a prior: the
+//      depth of the explored rooms on the same side of the same wall, else of the other hidden rooms on that
+//      side, else the room's width (a square, as the thesis does).
+// 3. The rectangle's unknown pixels connected to the door; pixels claimed by several rooms go to the nearest
+//    door.
+//
+// Parameters (config/prediction.yaml): start_search_radius and the default_* keys.
+// terms: "width", "depth" (metres), "depth_bounded" (1 when the depth came from the map, 0 from a prior),
+// "rotation" (degrees the map was turned).
+
+#include <map>
+#include <string>
+
+#include "hidden_rooms/room_predictor.h"
+
+namespace hidden_rooms {
+
+class DefaultPredictor : public RoomPredictor {
+ public:
+  DefaultPredictor() = default;
+  std::string name() const override { return "default"; }
+  std::map<std::string, double> defaultParameters() const override;
+  PredictionResult predict(const PredictionRequest& request) const override;
+};
+
+// Dominant wall direction of a map, radians in [-pi/4, pi/4): the walls run along this angle and the one
+// perpendicular to it (image frame: x = column, y = row). 0 when the map has no occupied cells.
+double dominantWallAngle(const OccupancyGrid& map);
+
+}  // namespace hidden_rooms

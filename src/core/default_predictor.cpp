@@ -1,0 +1,498 @@
+#include "hidden_rooms/default_predictor.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include <opencv2/imgproc.hpp>
+
+#include "hidden_rooms/input_error.h"
+#include "hidden_rooms/prediction_support.h"
+
+namespace hidden_rooms {
+
+namespace {
+
+// Defaults (documented in config/prediction.yaml).
+constexpr double kStartSearchRadius = 1.0;   // m (shared with the baselines)
+constexpr double kWallGap = 1.5;             // m: longest gap in the door's wall still followed
+constexpr double kMaxExtent = 25.0;          // m: longest lateral extent and depth searched
+constexpr double kBoundedFraction = 0.5;     // share of columns ending on a known pixel for a measured depth
+constexpr double kNeighbourReach = 15.0;     // m: how far along the wall explored neighbours are looked for
+constexpr double kMinDepth = 2.0;            // m: smallest depth taken from the square prior
+constexpr double kMinRotation = 1.0;         // degrees: smaller dominant angles are not corrected
+
+// Working states of a pixel.
+constexpr uint8_t kUnknownPx = 0, kFreePx = 1, kOccupiedPx = 2;
+
+cv::Mat1b statesOf(const OccupancyGrid& map) {
+  cv::Mat1b states(map.cells.size(), kUnknownPx);
+  for (int r = 0; r < map.height(); ++r)
+    for (int c = 0; c < map.width(); ++c) {
+      const int8_t v = map.cells(r, c);
+      if (v >= 50) states(r, c) = kOccupiedPx;
+      else if (v >= 0) states(r, c) = kFreePx;
+    }
+  return states;
+}
+
+struct Parameters {
+  double start_search_radius, wall_gap, max_extent, bounded_fraction, neighbour_reach, min_depth, min_rotation;
+};
+
+// A door in the working image: centre pixel, wall axis a and normal n (unit axis vectors, n into the unknown).
+struct DoorFrame {
+  bool ok = false;
+  std::string problem;
+  cv::Point p;
+  cv::Point a, n;
+  int half_width = 1;     // pixels
+  int band0 = 0, s0 = 0;  // wall rows v in [band0, s0), first unknown row s0
+  int left = 0, right = 0;  // lateral extent, u in [left, right]
+  bool lateral_open = false;
+  int depth = 0;           // pixels behind s0
+  bool bounded = false;
+  std::vector<int> bounded_depths;
+  double neighbour_depth = -1.0;
+};
+
+class Frame {
+ public:
+  Frame(const cv::Mat1b& states, const cv::Rect& box) : s_(states), box_(box) {}
+  cv::Point at(const DoorFrame& d, int u, int v) const { return d.p + u * d.a + v * d.n; }
+  bool inside(const cv::Point& q) const { return q.x >= 0 && q.y >= 0 && q.x < s_.cols && q.y < s_.rows; }
+  bool inBox(const cv::Point& q) const { return box_.contains(q); }
+  uint8_t state(const cv::Point& q) const { return inside(q) ? s_(q) : kUnknownPx; }
+
+ private:
+  const cv::Mat1b& s_;
+  cv::Rect box_;
+};
+
+int median(std::vector<int> values) {
+  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+  return values[values.size() / 2];
+}
+
+// Unknown fraction of the strip behind the door (width of the door, `depth` pixels) on side n.
+double unknownBehind(const Frame& f, DoorFrame d, int depth) {
+  int unknown = 0, total = 0;
+  for (int v = 1; v <= depth; ++v)
+    for (int u = -d.half_width; u <= d.half_width; ++u) {
+      ++total;
+      unknown += f.state(f.at(d, u, v)) == kUnknownPx && f.inside(f.at(d, u, v));
+    }
+  return total ? static_cast<double>(unknown) / total : 0.0;
+}
+
+// Side, wall rows and first unknown row of a door.
+void placeDoor(const Frame& f, double resolution, const Parameters& P, DoorFrame* d) {
+  const int reach = std::max(2, static_cast<int>(std::lround(P.start_search_radius / resolution)));
+  const cv::Point n0 = d->n;
+  const double plus = unknownBehind(f, *d, reach);
+  d->n = -n0;
+  const double minus = unknownBehind(f, *d, reach);
+  d->n = plus >= minus ? n0 : -n0;
+  if (std::max(plus, minus) <= 0.0) {
+    d->problem = "no unknown space behind the door";
+    return;
+  }
+  // First row behind the door (v >= -reach/2) where most of the door's width is unknown.
+  d->s0 = std::numeric_limits<int>::min();
+  for (int v = -reach / 2; v <= reach; ++v) {
+    int unknown = 0, total = 0;
+    for (int u = -d->half_width; u <= d->half_width; ++u) {
+      const cv::Point q = f.at(*d, u, v);
+      if (!f.inside(q)) continue;
+      ++total;
+      unknown += f.state(q) == kUnknownPx;
+    }
+    if (total && unknown * 2 > total) {
+      // The row must be followed by unknown rows (not a speck inside the wall).
+      d->s0 = v;
+      break;
+    }
+  }
+  if (d->s0 == std::numeric_limits<int>::min()) {
+    d->problem = "no unknown space behind the door";
+    return;
+  }
+  // Wall rows: occupied rows just before s0 (any pixel across the door width).
+  d->band0 = d->s0;
+  for (int v = d->s0 - 1; v >= d->s0 - reach; --v) {
+    bool occupied = false;
+    for (int u = -d->half_width; u <= d->half_width && !occupied; ++u)
+      occupied = f.state(f.at(*d, u, v)) == kOccupiedPx;
+    if (!occupied) break;
+    d->band0 = v;
+  }
+  if (d->band0 == d->s0) d->band0 = d->s0 - 1;
+  d->ok = true;
+}
+
+// How far the room reaches along the wall in direction `sign`.
+int lateralExtent(const Frame& f, double resolution, const Parameters& P, DoorFrame* d, int sign) {
+  const int max_u = static_cast<int>(P.max_extent / resolution);
+  const int gap_limit = std::max(1, static_cast<int>(P.wall_gap / resolution));
+  const int probe1 = std::max(2, static_cast<int>(0.4 / resolution));
+  const int probe2 = std::max(3, static_cast<int>(0.8 / resolution));
+  int last_wall = 0, gap = 0;
+  // The wall is tracked: its rows may drift by a few pixels (slightly tilted walls of SLAM maps).
+  int band0 = d->band0, band1 = d->s0 - 1;
+  const int persistence = std::max(2, static_cast<int>(std::lround(0.15 / resolution)));
+  int known_run = 0;
+  for (int k = 1; k <= max_u; ++k) {
+    const int u = sign * k;
+    const cv::Point behind = f.at(*d, u, d->s0 + 1);
+    if (!f.inside(behind)) {
+      d->lateral_open = true;
+      return sign * std::max(k - 1, last_wall);
+    }
+    // Known space behind the wall over a few columns: a perpendicular wall of an explored room.
+    int known = 0;
+    for (int v : {band1 + 2, band1 + probe1, band1 + probe2}) known += f.state(f.at(*d, u, v)) != kUnknownPx;
+    if (known >= 2) {
+      if (++known_run >= persistence) return sign * (k - known_run);
+    } else {
+      known_run = 0;
+    }
+    int first = std::numeric_limits<int>::max(), last = std::numeric_limits<int>::min();
+    for (int v = band0 - 2; v <= band1 + 2; ++v)
+      if (f.state(f.at(*d, u, v)) == kOccupiedPx) first = std::min(first, v), last = std::max(last, v);
+    if (last >= first) {
+      gap = 0;
+      last_wall = k;
+      band0 = first;
+      band1 = std::max(last, first);
+    } else if (++gap > gap_limit) {
+      return sign * last_wall;
+    }
+  }
+  return sign * max_u;
+}
+
+// Per column of the extent, the unknown run behind the wall; sets depth when enough columns end on known space.
+void measureDepth(const Frame& f, double resolution, const Parameters& P, DoorFrame* d) {
+  const int max_v = static_cast<int>(P.max_extent / resolution);
+  const int width = d->right - d->left + 1;
+  const int margin = width / 10;
+  d->bounded_depths.clear();
+  int columns = 0;
+  for (int u = d->left + margin; u <= d->right - margin; ++u) {
+    ++columns;
+    for (int v = d->s0; v <= d->s0 + max_v; ++v) {
+      const cv::Point q = f.at(*d, u, v);
+      if (!f.inside(q) || !f.inBox(q)) break;
+      if (f.state(q) != kUnknownPx) {
+        d->bounded_depths.push_back(v - d->s0);
+        break;
+      }
+    }
+  }
+  d->bounded = columns > 0 && d->bounded_depths.size() >= P.bounded_fraction * columns;
+  if (d->bounded) d->depth = median(d->bounded_depths);
+}
+
+// Depth of explored rooms on the same side of the same wall, within reach of the door's extent.
+double neighbourDepth(const Frame& f, double resolution, const Parameters& P, const DoorFrame& d) {
+  const int reach = static_cast<int>(P.neighbour_reach / resolution);
+  const int max_v = static_cast<int>(P.max_extent / resolution);
+  const int entry = std::max(2, static_cast<int>(0.5 / resolution));
+  const int unknown_run_limit = std::max(2, static_cast<int>(0.5 / resolution));
+  std::vector<int> depths;
+  for (int sign : {-1, 1}) {
+    const int start = sign < 0 ? d.left - 1 : d.right + 1;
+    for (int k = 0; k < reach; ++k) {
+      const int u = start + sign * k;
+      // An occupied pixel (the wall) then a free pixel just behind the wall line: an explored room there.
+      int v = d.band0 - 3;
+      while (v <= d.s0 + entry && f.state(f.at(d, u, v)) != kOccupiedPx) ++v;
+      while (v <= d.s0 + entry && f.state(f.at(d, u, v)) != kFreePx) ++v;
+      if (v > d.s0 + entry || v < d.s0 - 1) continue;
+      int unknown_run = 0;
+      bool closed = false;
+      for (; v <= d.s0 + max_v; ++v) {
+        const cv::Point q = f.at(d, u, v);
+        if (!f.inside(q)) break;
+        const uint8_t s = f.state(q);
+        if (s == kOccupiedPx) {
+          closed = true;
+          break;
+        }
+        unknown_run = s == kUnknownPx ? unknown_run + 1 : 0;
+        if (unknown_run > unknown_run_limit) break;
+      }
+      if (closed) depths.push_back(v - d.s0);
+    }
+  }
+  if (depths.size() < static_cast<size_t>(std::max(3, static_cast<int>(1.0 / resolution)))) return -1.0;
+  const int depth = median(depths);
+  return depth * resolution >= P.min_depth ? depth : -1.0;
+}
+
+// Rotation of a point about the working transform.
+cv::Point2d applyAffine(const cv::Matx23d& m, const cv::Point2d& p) {
+  return {m(0, 0) * p.x + m(0, 1) * p.y + m(0, 2), m(1, 0) * p.x + m(1, 1) * p.y + m(1, 2)};
+}
+
+}  // namespace
+
+double dominantWallAngle(const OccupancyGrid& map) {
+  cv::Mat1f occupied(map.cells.size(), 0.0f);
+  for (int r = 0; r < map.height(); ++r)
+    for (int c = 0; c < map.width(); ++c) occupied(r, c) = map.cells(r, c) >= 50 ? 1.0f : 0.0f;
+  cv::GaussianBlur(occupied, occupied, cv::Size(0, 0), 2.5);
+  cv::Mat1f gx, gy;
+  cv::Sobel(occupied, gx, CV_32F, 1, 0, 5);
+  cv::Sobel(occupied, gy, CV_32F, 0, 1, 5);
+  constexpr int kBins = 180;  // half-degree bins over 90 degrees
+  std::vector<double> histogram(kBins, 0.0);
+  for (int r = 0; r < map.height(); ++r)
+    for (int c = 0; c < map.width(); ++c) {
+      const double x = gx(r, c), y = gy(r, c);
+      const double magnitude = std::hypot(x, y);
+      if (magnitude < 1e-3) continue;
+      double angle = std::atan2(y, x);  // gradient direction; walls run perpendicular: same modulo 90 degrees
+      angle = std::fmod(angle + 4.0 * CV_PI, CV_PI / 2.0);
+      const int bin = std::min(kBins - 1, static_cast<int>(angle / (CV_PI / 2.0) * kBins));
+      histogram[bin] += magnitude;
+    }
+  int best = 0;
+  double best_value = -1.0;
+  for (int b = 0; b < kBins; ++b) {
+    double value = 0.0;
+    for (int k = -3; k <= 3; ++k) value += histogram[(b + k + kBins) % kBins];
+    if (value > best_value) best_value = value, best = b;
+  }
+  if (best_value <= 0.0) return 0.0;
+  // Weighted mean around the peak (circular over the 90 degree period).
+  double sum = 0.0, weight = 0.0;
+  for (int k = -6; k <= 6; ++k) {
+    const double w = histogram[(best + k + kBins) % kBins];
+    sum += w * (best + k + 0.5);
+    weight += w;
+  }
+  double angle = (sum / weight) / kBins * (CV_PI / 2.0);
+  angle = std::fmod(angle + CV_PI, CV_PI / 2.0);
+  if (angle >= CV_PI / 4.0) angle -= CV_PI / 2.0;
+  return angle;
+}
+
+std::map<std::string, double> DefaultPredictor::defaultParameters() const {
+  return {{"start_search_radius", kStartSearchRadius}, {"default_wall_gap", kWallGap},
+          {"default_max_extent", kMaxExtent},          {"default_bounded_fraction", kBoundedFraction},
+          {"default_neighbour_reach", kNeighbourReach}, {"default_min_depth", kMinDepth},
+          {"default_min_rotation", kMinRotation}};
+}
+
+PredictionResult DefaultPredictor::predict(const PredictionRequest& request) const {
+  const auto start_time = std::chrono::steady_clock::now();
+  checkUsableMap(request.map);
+  const auto values = resolveParameters(*this, request.parameters);
+  const Parameters P{values.at("start_search_radius"), values.at("default_wall_gap"),
+                     values.at("default_max_extent"),  values.at("default_bounded_fraction"),
+                     values.at("default_neighbour_reach"), values.at("default_min_depth"),
+                     values.at("default_min_rotation")};
+  if (P.start_search_radius <= 0.0 || P.wall_gap < 0.0 || P.max_extent <= 0.0 || P.neighbour_reach < 0.0 ||
+      P.min_depth < 0.0 || P.min_rotation < 0.0 || P.bounded_fraction < 0.0 || P.bounded_fraction > 1.0)
+    throw InputError("parameters", "default_* parameters out of range");
+  const OccupancyGrid& map = request.map;
+  const double resolution = map.resolution;
+
+  // 1. Orientation.
+  const double angle = dominantWallAngle(map);
+  const bool rotate = std::abs(angle) * 180.0 / CV_PI >= P.min_rotation;
+  cv::Mat1b states = statesOf(map);
+  cv::Matx23d forward(1, 0, 0, 0, 1, 0);
+  cv::Size work_size = states.size();
+  if (rotate) {
+    const double c = std::cos(-angle), s = std::sin(-angle);
+    const double w = states.cols, h = states.rows;
+    const int W = static_cast<int>(std::ceil(std::abs(c) * w + std::abs(s) * h)) + 2;
+    const int H = static_cast<int>(std::ceil(std::abs(s) * w + std::abs(c) * h)) + 2;
+    const cv::Point2d centre(w / 2.0, h / 2.0), new_centre(W / 2.0, H / 2.0);
+    forward = cv::Matx23d(c, -s, new_centre.x - (c * centre.x - s * centre.y), s, c,
+                          new_centre.y - (s * centre.x + c * centre.y));
+    work_size = cv::Size(W, H);
+    cv::Mat1b rotated;
+    cv::warpAffine(states, rotated, cv::Mat(forward), work_size, cv::INTER_NEAREST, cv::BORDER_CONSTANT,
+                   cv::Scalar(kUnknownPx));
+    states = rotated;
+  }
+  cv::Rect box;
+  {
+    cv::Mat1b known = states != kUnknownPx;
+    std::vector<cv::Point> points;
+    cv::findNonZero(known, points);
+    box = cv::boundingRect(points);
+  }
+  const Frame f(states, box);
+
+  // 2. Doors.
+  const size_t count = request.doors.doors.size();
+  std::vector<DoorFrame> doors(count);
+  std::vector<std::string> problems(count);
+  for (size_t i = 0; i < count; ++i) {
+    const MapDoor& door = request.doors.doors[i];
+    DoorFrame& d = doors[i];
+    cv::Point unused;
+    if (!nearestUnknownCell(map, door.position, P.start_search_radius, &unused, &d.problem)) continue;
+    const Point2 image = map.toImage(door.position);
+    const cv::Point2d q = applyAffine(forward, cv::Point2d(image.x(), image.y()));
+    d.p = cv::Point(static_cast<int>(std::floor(q.x)), static_cast<int>(std::floor(q.y)));
+    d.a = door.orientation == DoorOrientation::kAlongX ? cv::Point(1, 0) : cv::Point(0, 1);
+    d.n = cv::Point(d.a.y, d.a.x);
+    d.half_width = std::max(1, static_cast<int>(0.5 * door.width / resolution));
+    placeDoor(f, resolution, P, &d);
+    if (!d.ok) continue;
+    d.left = lateralExtent(f, resolution, P, &d, -1);
+    d.right = lateralExtent(f, resolution, P, &d, +1);
+  }
+
+  // Doors on the same wall and side share its extent: cut at the midpoints.
+  auto along = [](const DoorFrame& d, const cv::Point& q) { return d.a.x * q.x + d.a.y * q.y; };
+  auto across = [](const DoorFrame& d, const cv::Point& q) { return d.n.x * q.x + d.n.y * q.y; };
+  const int same_wall = std::max(2, static_cast<int>(0.6 / resolution));
+  std::vector<std::vector<int>> siblings(count);
+  for (size_t i = 0; i < count; ++i) {
+    if (!doors[i].ok) continue;
+    DoorFrame& d = doors[i];
+    const int ci = along(d, d.p), wall_i = across(d, d.p) + d.s0;
+    int left = d.left, right = d.right;
+    for (size_t j = 0; j < count; ++j) {
+      if (j == i || !doors[j].ok) continue;
+      const DoorFrame& e = doors[j];
+      if (e.a != d.a || e.n != d.n) continue;
+      if (std::abs(across(e, e.p) + e.s0 - wall_i) > same_wall) continue;
+      const int offset = (along(e, e.p) - ci) * (d.a.x + d.a.y);  // u of the other door in d's frame
+      if (offset < d.left || offset > d.right) continue;
+      siblings[i].push_back(static_cast<int>(j));
+      if (offset > 0) right = std::min(right, offset / 2);
+      else if (offset < 0) left = std::max(left, offset / 2 + 1);
+    }
+    d.left = left;
+    d.right = right;
+  }
+  for (size_t i = 0; i < count; ++i)
+    if (doors[i].ok) measureDepth(f, resolution, P, &doors[i]);
+  for (size_t i = 0; i < count; ++i) {
+    DoorFrame& d = doors[i];
+    if (!d.ok || d.bounded) continue;
+    double depth = neighbourDepth(f, resolution, P, d);
+    if (depth < 0) {
+      std::vector<int> sibling_depths;
+      for (int j : siblings[i])
+        if (doors[j].bounded) sibling_depths.push_back(doors[j].depth);
+      if (!sibling_depths.empty()) depth = median(sibling_depths);
+    }
+    if (depth < 0) depth = std::max(static_cast<double>(d.right - d.left + 1), P.min_depth / resolution);
+    d.depth = static_cast<int>(std::lround(depth));
+  }
+
+  // Rectangles (working image, [x0, x1] x [y0, y1] inclusive); overlapping rooms are cut apart by an
+  // axis-aligned line halfway between their doors, across the axis along which the doors lie farther apart.
+  std::vector<cv::Rect> rects(count);
+  for (size_t i = 0; i < count; ++i) {
+    const DoorFrame& d = doors[i];
+    if (!d.ok) continue;
+    const cv::Point c1 = f.at(d, d.left, d.s0), c2 = f.at(d, d.right, d.s0 + d.depth);
+    rects[i] = cv::Rect(cv::Point(std::min(c1.x, c2.x), std::min(c1.y, c2.y)),
+                        cv::Point(std::max(c1.x, c2.x) + 1, std::max(c1.y, c2.y) + 1));
+  }
+  for (size_t i = 0; i < count; ++i)
+    for (size_t j = i + 1; j < count; ++j) {
+      if (!doors[i].ok || !doors[j].ok || (rects[i] & rects[j]).area() == 0) continue;
+      const cv::Point pi = f.at(doors[i], 0, doors[i].s0), pj = f.at(doors[j], 0, doors[j].s0);
+      auto cut = [](cv::Rect* r, int lo, int hi, bool x_axis) {  // keep [lo, hi) along the axis
+        int a = x_axis ? r->x : r->y, b = x_axis ? r->x + r->width : r->y + r->height;
+        a = std::max(a, lo), b = std::min(b, hi);
+        if (b < a) b = a;
+        if (x_axis) r->x = a, r->width = b - a;
+        else r->y = a, r->height = b - a;
+      };
+      auto split = [&](bool cut_x, cv::Rect* ri, cv::Rect* rj) {
+        const int ci = cut_x ? pi.x : pi.y, cj = cut_x ? pj.x : pj.y;
+        const int mid = (ci + cj + 1) / 2;
+        const int big = std::numeric_limits<int>::max() / 4;
+        cut(ri, ci < cj ? -big : mid, ci < cj ? mid : big, cut_x);
+        cut(rj, ci < cj ? mid : -big, ci < cj ? big : mid, cut_x);
+        return ci != cj;
+      };
+      // Both cuts are tried; the one keeping more of the two rooms wins (doors in line: only the cut between).
+      cv::Rect xi = rects[i], xj = rects[j], yi = rects[i], yj = rects[j];
+      const bool x_ok = split(true, &xi, &xj), y_ok = split(false, &yi, &yj);
+      const bool use_x = x_ok && (!y_ok || xi.area() + xj.area() >= yi.area() + yj.area());
+      rects[i] = use_x ? xi : yi;
+      rects[j] = use_x ? xj : yj;
+    }
+
+  // 3. Masks in the working frame; overlaps left go to the nearest door.
+  std::vector<cv::Mat1b> masks(count);
+  cv::Mat1s owner(work_size, static_cast<short>(-1));
+  const cv::Mat1b unknown = states == kUnknownPx;
+  for (size_t i = 0; i < count; ++i) {
+    const DoorFrame& d = doors[i];
+    if (!d.ok) continue;
+    const cv::Rect rect = rects[i] & cv::Rect(0, 0, work_size.width, work_size.height);
+    masks[i] = cv::Mat1b::zeros(work_size);
+    if (rect.area() == 0) continue;
+    masks[i](rect).setTo(255, unknown(rect));
+    for (int r = rect.y; r < rect.br().y; ++r)
+      for (int c = rect.x; c < rect.br().x; ++c) {
+        if (!masks[i](r, c)) continue;
+        short& o = owner(r, c);
+        if (o < 0) {
+          o = static_cast<short>(i);
+          continue;
+        }
+        const cv::Point q(c, r);
+        const cv::Point po = doors[o].p, pi = d.p;
+        const double di = cv::norm(q - pi), dout = cv::norm(q - po);
+        if (di < dout) o = static_cast<short>(i);
+      }
+  }
+  for (size_t i = 0; i < count; ++i) {
+    if (!doors[i].ok || masks[i].empty()) continue;
+    masks[i].setTo(0, owner != static_cast<short>(i));
+    // Keep what is connected to the door.
+    const cv::Point seed = f.at(doors[i], 0, doors[i].s0);
+    if (!f.inside(seed) || !masks[i](seed)) {
+      // The door's own column may be claimed by another room: keep the largest part instead.
+      continue;
+    }
+    cv::Mat1b flood = cv::Mat1b::zeros(work_size.height + 2, work_size.width + 2);
+    cv::floodFill(masks[i], flood, seed, 255, nullptr, 0, 0, 4 | cv::FLOODFILL_MASK_ONLY | (255 << 8));
+    masks[i] = flood(cv::Rect(1, 1, work_size.width, work_size.height)).clone();
+  }
+
+  // Back to the map's frame.
+  PredictionResult result;
+  const cv::Mat1b map_unknown = map.cells == OccupancyGrid::kUnknown;
+  for (size_t i = 0; i < count; ++i) {
+    RoomPrediction room;
+    room.door_id = request.doors.doors[i].id;
+    room.problem = doors[i].problem;
+    if (doors[i].ok && !masks[i].empty()) {
+      if (rotate) {
+        cv::warpAffine(masks[i], room.mask, cv::Mat(forward), map.cells.size(),
+                       cv::INTER_NEAREST | cv::WARP_INVERSE_MAP, cv::BORDER_CONSTANT, cv::Scalar(0));
+      } else {
+        room.mask = masks[i];
+      }
+      room.mask.setTo(0, ~map_unknown);
+      room.terms["width"] = (doors[i].right - doors[i].left + 1) * resolution;
+      room.terms["depth"] = doors[i].depth * resolution;
+      room.terms["depth_bounded"] = doors[i].bounded ? 1.0 : 0.0;
+      room.terms["rotation"] = angle * 180.0 / CV_PI;
+    } else {
+      room.mask = cv::Mat1b::zeros(map.cells.size());
+    }
+    finishPrediction(map, &room);
+    result.rooms.push_back(std::move(room));
+  }
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
+  return result;
+}
+
+}  // namespace hidden_rooms
