@@ -2,7 +2,7 @@
 # The main job of hidden_rooms, as far as the package goes today: sets up, renders the default world with some
 # doors closed and the rooms behind them unseen (the map a robot would build), predicts those rooms and scores
 # the prediction against the truth. Everything goes to demo_output/.
-#   scripts/demo.sh [--world WORLD.xml] [--closed 2,6,9,13] [--method unstructured] [--gui]
+#   scripts/demo.sh [--world WORLD.xml] [--closed 2,6,9,13] [--method default] [--gui]
 # --gui also shows the world in rviz (needs a display).
 set -euo pipefail
 
@@ -11,7 +11,7 @@ ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 export PATH="/usr/bin:$PATH"
 WORLD="$ROOT/worlds/medium_1.xml"
 CLOSED="2,6,9,13"
-METHOD="unstructured"
+METHOD="default"
 GUI=false
 while [ $# -gt 0 ]; do
   case "$1" in

@@ -145,7 +145,7 @@ TEST(DefaultPredictor, RejectsBadParameters) {
 }
 
 // Mean IoU of `default` over the benchmark's 44 valid cases; the floor sits a little under the measured mean
-// (0.545), so that a regression fails.
+// (0.658), so that a regression fails.
 TEST(DefaultPredictor, KeepsItsAccuracyOnTheBenchmark) {
   HIDDEN_ROOMS_REQUIRE_SHARED_DATA();
   const std::string root = testing::sharedDir() + "/data/closed_door_benchmark";
@@ -175,7 +175,7 @@ TEST(DefaultPredictor, KeepsItsAccuracyOnTheBenchmark) {
     ++cases;
   }
   ASSERT_EQ(cases, 44);
-  EXPECT_GE(total / cases, 0.52);
+  EXPECT_GE(total / cases, 0.64);
 }
 
 }  // namespace

@@ -103,9 +103,9 @@ TEST(ThesisTerms, UtilityFunctionsOfTheThesis) {
   EXPECT_NEAR(thesisScore(t, true), -1.0 - 12.5 + 0.06 * 60.0 - 2.0 * 0.5 * 0.5, 1e-12);
 }
 
-// Expansion on a hand-made layout: a 2 x 2 block of OUT cells behind a door in a row of IN cells, walled by IN
-// cells on both sides, OUT border cells around.
-TEST(ThesisExpansion, FillsAWalledBlock) {
+// A hand-made layout: a 2 x 2 block of OUT cells behind a door in a row of IN cells (the corridor), walled by
+// IN cells (explored rooms) on both sides, OUT border cells around.
+Layout walledBlockLayout() {
   Layout layout;
   layout.grid = squareGrid(6, 5, 40);
   CellGrid& grid = layout.grid;
@@ -124,6 +124,12 @@ TEST(ThesisExpansion, FillsAWalledBlock) {
   door.edge.a = Point2(80, 120);
   door.edge.b = Point2(120, 120);
   layout.doors = {door};
+  return layout;
+}
+
+TEST(ThesisExpansion, FillsAWalledBlock) {
+  const Layout layout = walledBlockLayout();
+  const CellGrid& grid = layout.grid;
   const std::vector<ThesisRoomCells> rooms = thesisRoomCells(layout);
   ASSERT_EQ(rooms.size(), 1u);
   std::vector<int> expected{grid.index(2, 1), grid.index(3, 1), grid.index(2, 2), grid.index(3, 2)};
@@ -276,24 +282,7 @@ TEST(ThesisPredictor, DoorOutsideTheMapIsReportedAndTheOthersPredicted) {
 TEST(ThesisExpansion, CappedCandidatesAreReported) {
   // The walled block of FillsAWalledBlock: the start cell has 3 candidates; with 1 kept per step the room
   // still fills the block, one cell at a time.
-  Layout layout;
-  layout.grid = squareGrid(6, 5, 40);
-  CellGrid& grid = layout.grid;
-  for (int i = 0; i < 6; ++i) setIn(&grid, i, 3);
-  setIn(&grid, 1, 1);
-  setIn(&grid, 1, 2);
-  setIn(&grid, 4, 1);
-  setIn(&grid, 4, 2);
-  for (int c = 0; c < grid.size(); ++c)
-    grid.cells[c].border = grid.column(c) == 0 || grid.row(c) == 0 || grid.column(c) == 5 || grid.row(c) == 4;
-  DoorStart door;
-  door.door_id = 1;
-  door.found = true;
-  door.start_cell = grid.index(2, 2);
-  door.explored_cell = grid.index(2, 3);
-  door.edge.a = Point2(80, 120);
-  door.edge.b = Point2(120, 120);
-  layout.doors = {door};
+  const Layout layout = walledBlockLayout();
   ThesisOptions capped;
   capped.max_candidates = 1;
   const std::vector<ThesisRoomCells> rooms = thesisRoomCells(layout, capped);

@@ -1,8 +1,13 @@
 #pragma once
 
-// The project's own prediction method, "default": one rectangle per closed door, fitted to the walls the robot
-// saw around the door.
+// The project's own prediction method, "default": per closed door, the room grown on the layout's cell grid by
+// the thesis's method (thesis_predictor.h, with its default parameters), or a rectangle fitted to the walls the
+// robot saw around the door when the grown room is smaller than default_grown_area_ratio times the rectangle
+// (the growth stopped short of the walls the rectangle found) or missing. A rectangle gives up the pixels of
+// the grown rooms kept for the other doors. On a map whose dominant wall angle is at least default_min_rotation
+// (the layout's cells are axis-aligned) every door gets its rectangle.
 //
+// The rectangles:
 // 1. Orientation: the dominant wall direction (modulo 90 degrees) from the gradient directions of the occupied
 //    pixels; the map and its doors are rotated so that the walls run along x and y, and the rooms are rotated
 //    back at the end.
@@ -20,7 +25,8 @@
 //    door.
 //
 // Parameters (config/prediction.yaml): start_search_radius and the default_* keys.
-// terms: "width", "depth" (metres), "depth_bounded" (1 when the depth came from the map, 0 from a prior),
+// terms: "rectangle" (1 when the rectangle was chosen, 0 the grown room); a grown room has the thesis's terms, a
+// rectangle "width", "depth" (metres), "depth_bounded" (1 when the depth came from the map, 0 from a prior) and
 // "rotation" (degrees the map was turned).
 
 #include <map>

@@ -26,6 +26,9 @@ bool nearestUnknownCell(const OccupancyGrid& map, const Point2& position, double
 // and sets placed = true; an empty mask makes it not placed with `problem` "no room predicted".
 void finishPrediction(const OccupancyGrid& map, RoomPrediction* room);
 
+// The prediction of a door that could not be placed: empty mask of the map's size, placed = false, `problem`.
+RoomPrediction unplacedRoom(const OccupancyGrid& map, int door_id, const std::string& problem);
+
 // Throws InputError when the map has no cells or no known cell.
 void checkUsableMap(const OccupancyGrid& map);
 

@@ -9,6 +9,7 @@
 
 #include "hidden_rooms/input_error.h"
 #include "hidden_rooms/prediction_support.h"
+#include "hidden_rooms/thesis_predictor.h"
 
 namespace hidden_rooms {
 
@@ -22,6 +23,7 @@ constexpr double kBoundedFraction = 0.5;     // share of columns ending on a kno
 constexpr double kNeighbourReach = 15.0;     // m: how far along the wall explored neighbours are looked for
 constexpr double kMinDepth = 2.0;            // m: smallest depth taken from the square prior
 constexpr double kMinRotation = 1.0;         // degrees: smaller dominant angles are not corrected
+constexpr double kGrownAreaRatio = 0.6;      // grown rooms smaller than this share of the rectangle give way
 
 // Working states of a pixel.
 constexpr uint8_t kUnknownPx = 0, kFreePx = 1, kOccupiedPx = 2;
@@ -39,6 +41,7 @@ cv::Mat1b statesOf(const OccupancyGrid& map) {
 
 struct Parameters {
   double start_search_radius, wall_gap, max_extent, bounded_fraction, neighbour_reach, min_depth, min_rotation;
+  double grown_area_ratio;
 };
 
 // A door in the working image: centre pixel, wall axis a and normal n (unit axis vectors, n into the unknown).
@@ -283,25 +286,18 @@ std::map<std::string, double> DefaultPredictor::defaultParameters() const {
   return {{"start_search_radius", kStartSearchRadius}, {"default_wall_gap", kWallGap},
           {"default_max_extent", kMaxExtent},          {"default_bounded_fraction", kBoundedFraction},
           {"default_neighbour_reach", kNeighbourReach}, {"default_min_depth", kMinDepth},
-          {"default_min_rotation", kMinRotation}};
+          {"default_min_rotation", kMinRotation},       {"default_grown_area_ratio", kGrownAreaRatio}};
 }
 
-PredictionResult DefaultPredictor::predict(const PredictionRequest& request) const {
-  const auto start_time = std::chrono::steady_clock::now();
-  checkUsableMap(request.map);
-  const auto values = resolveParameters(*this, request.parameters);
-  const Parameters P{values.at("start_search_radius"), values.at("default_wall_gap"),
-                     values.at("default_max_extent"),  values.at("default_bounded_fraction"),
-                     values.at("default_neighbour_reach"), values.at("default_min_depth"),
-                     values.at("default_min_rotation")};
-  if (P.start_search_radius <= 0.0 || P.wall_gap < 0.0 || P.max_extent <= 0.0 || P.neighbour_reach < 0.0 ||
-      P.min_depth < 0.0 || P.min_rotation < 0.0 || P.bounded_fraction < 0.0 || P.bounded_fraction > 1.0)
-    throw InputError("parameters", "default_* parameters out of range");
+namespace {
+
+// The wall-fitted rectangle of every door (steps 1 to 3 of the header), in the map's frame; `angle` is the map's
+// dominantWallAngle.
+std::vector<RoomPrediction> rectangleRooms(const PredictionRequest& request, const Parameters& P, double angle) {
   const OccupancyGrid& map = request.map;
   const double resolution = map.resolution;
 
   // 1. Orientation.
-  const double angle = dominantWallAngle(map);
   const bool rotate = std::abs(angle) * 180.0 / CV_PI >= P.min_rotation;
   cv::Mat1b states = statesOf(map);
   cv::Matx23d forward(1, 0, 0, 0, 1, 0);
@@ -467,7 +463,7 @@ PredictionResult DefaultPredictor::predict(const PredictionRequest& request) con
   }
 
   // Back to the map's frame.
-  PredictionResult result;
+  std::vector<RoomPrediction> rooms;
   const cv::Mat1b map_unknown = map.cells == OccupancyGrid::kUnknown;
   for (size_t i = 0; i < count; ++i) {
     RoomPrediction room;
@@ -489,6 +485,53 @@ PredictionResult DefaultPredictor::predict(const PredictionRequest& request) con
       room.mask = cv::Mat1b::zeros(map.cells.size());
     }
     finishPrediction(map, &room);
+    rooms.push_back(std::move(room));
+  }
+  return rooms;
+}
+
+}  // namespace
+
+PredictionResult DefaultPredictor::predict(const PredictionRequest& request) const {
+  const auto start_time = std::chrono::steady_clock::now();
+  checkUsableMap(request.map);
+  const auto values = resolveParameters(*this, request.parameters);
+  const Parameters P{values.at("start_search_radius"),     values.at("default_wall_gap"),
+                     values.at("default_max_extent"),      values.at("default_bounded_fraction"),
+                     values.at("default_neighbour_reach"), values.at("default_min_depth"),
+                     values.at("default_min_rotation"),    values.at("default_grown_area_ratio")};
+  if (P.start_search_radius <= 0.0 || P.wall_gap < 0.0 || P.max_extent <= 0.0 || P.neighbour_reach < 0.0 ||
+      P.min_depth < 0.0 || P.min_rotation < 0.0 || P.bounded_fraction < 0.0 || P.bounded_fraction > 1.0 ||
+      P.grown_area_ratio < 0.0)
+    throw InputError("parameters", "default_* parameters out of range");
+
+  const double angle = dominantWallAngle(request.map);
+  std::vector<RoomPrediction> rectangles = rectangleRooms(request, P, angle);
+  // The layout's cells are axis-aligned: on a turned map only the rectangles (built on the map turned straight).
+  const bool turned = std::abs(angle) * 180.0 / CV_PI >= P.min_rotation;
+  PredictionRequest grown_request;
+  grown_request.map = request.map;
+  grown_request.doors = request.doors;
+  std::vector<RoomPrediction> grown =
+      turned ? std::vector<RoomPrediction>(rectangles.size()) : ThesisPredictor().predict(grown_request).rooms;
+
+  // Per door: the grown room, unless it is much smaller than the rectangle (it stopped short of the walls the
+  // rectangle found) or missing; a rectangle gives up the pixels of the grown rooms kept for other doors.
+  const size_t count = rectangles.size();
+  std::vector<bool> use_rectangle(count, false);
+  cv::Mat1b kept_grown = cv::Mat1b::zeros(request.map.cells.size());
+  for (size_t i = 0; i < count; ++i) {
+    use_rectangle[i] = turned || (rectangles[i].placed && grown[i].area < P.grown_area_ratio * rectangles[i].area);
+    if (!use_rectangle[i] && grown[i].placed) kept_grown |= grown[i].mask;
+  }
+  PredictionResult result;
+  for (size_t i = 0; i < count; ++i) {
+    RoomPrediction room = std::move(use_rectangle[i] ? rectangles[i] : grown[i]);
+    if (use_rectangle[i]) {
+      room.mask.setTo(0, kept_grown);
+      finishPrediction(request.map, &room);
+    }
+    room.terms["rectangle"] = use_rectangle[i] ? 1.0 : 0.0;
     result.rooms.push_back(std::move(room));
   }
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();

@@ -63,6 +63,15 @@ void finishPrediction(const OccupancyGrid& map, RoomPrediction* room) {
   for (const cv::Point& p : *largest) room->polygon.push_back(map.cellCentre(p.x, p.y));
 }
 
+RoomPrediction unplacedRoom(const OccupancyGrid& map, int door_id, const std::string& problem) {
+  RoomPrediction room;
+  room.door_id = door_id;
+  room.mask = cv::Mat1b::zeros(map.cells.size());
+  room.problem = problem;
+  finishPrediction(map, &room);
+  return room;
+}
+
 void checkUsableMap(const OccupancyGrid& map) {
   if (map.empty()) throw InputError("map", "the map is empty");
   if (cv::countNonZero(map.cells != OccupancyGrid::kUnknown) == 0)

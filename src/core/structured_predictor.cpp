@@ -49,12 +49,7 @@ PredictionResult StructuredPredictor::predict(const PredictionRequest& request) 
   for (size_t d = 0; d < request.doors.doors.size(); ++d) {
     const DoorStart& start = layout.doors[d];
     if (!start.found) {
-      RoomPrediction room;
-      room.door_id = request.doors.doors[d].id;
-      room.mask = cv::Mat1b::zeros(request.map.cells.size());
-      room.problem = start.problem;
-      finishPrediction(request.map, &room);
-      result.rooms.push_back(std::move(room));
+      result.rooms.push_back(unplacedRoom(request.map, request.doors.doors[d].id, start.problem));
       continue;
     }
     const std::vector<int> cells = structuredRoomCells(layout, start);

@@ -834,12 +834,7 @@ PredictionResult ThesisPredictor::predict(const PredictionRequest& request) cons
     const DoorStart& start = layout.doors[d];
     const ThesisRoomCells& cells = rooms[d];
     if (!start.found) {
-      RoomPrediction room;
-      room.door_id = request.doors.doors[d].id;
-      room.mask = cv::Mat1b::zeros(request.map.cells.size());
-      room.problem = start.problem;
-      finishPrediction(request.map, &room);
-      result.rooms.push_back(std::move(room));
+      result.rooms.push_back(unplacedRoom(request.map, request.doors.doors[d].id, start.problem));
       continue;
     }
     RoomPrediction room;
