@@ -10,6 +10,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "hidden_rooms/input_error.h"
+#include "hidden_rooms/parameter_table.h"
 
 namespace hidden_rooms {
 
@@ -18,10 +19,7 @@ namespace hidden_rooms {
 
 namespace {
 
-struct ParameterField {
-  const char* name;
-  double LayoutOptions::*field;
-};
+using ParameterField = hidden_rooms::ParameterField<LayoutOptions>;
 
 // config/layout.yaml's order.
 const std::vector<ParameterField>& parameterFields() {
@@ -70,25 +68,16 @@ bool isInteger(double value) { return std::abs(value - std::round(value)) < 1e-9
 }  // namespace
 
 const std::vector<std::string>& layoutParameterNames() {
-  static const std::vector<std::string> names = [] {
-    std::vector<std::string> list;
-    for (const ParameterField& field : parameterFields()) list.push_back(field.name);
-    return list;
-  }();
+  static const std::vector<std::string> names = parameterNames(parameterFields());
   return names;
 }
 
 std::map<std::string, double> layoutParameters(const LayoutOptions& options) {
-  std::map<std::string, double> parameters;
-  for (const ParameterField& field : parameterFields()) parameters[field.name] = options.*field.field;
-  return parameters;
+  return parameterValues(parameterFields(), options);
 }
 
 void applyLayoutParameters(const std::map<std::string, double>& parameters, LayoutOptions* options) {
-  for (const ParameterField& field : parameterFields()) {
-    const auto found = parameters.find(field.name);
-    if (found != parameters.end()) options->*field.field = found->second;
-  }
+  applyParameterValues(parameterFields(), parameters, options);
   validateLayoutOptions(*options);
 }
 
@@ -104,9 +93,7 @@ LayoutOptions layoutOptionsFromParameters(const std::map<std::string, double>& p
 
 void validateLayoutOptions(const LayoutOptions& o) {
   constexpr double kInf = std::numeric_limits<double>::infinity();
-  for (const ParameterField& field : parameterFields())
-    if (!std::isfinite(o.*field.field))
-      throw InputError("parameters", std::string("parameter '") + field.name + "' is not finite");
+  requireFiniteParameters(parameterFields(), o);
   requireRange("binary_threshold", o.binary_threshold, 0, 255, false, false);
   requireRange("canny_low_threshold", o.canny_low_threshold, 0, kInf, false, true);
   requireRange("canny_high_threshold", o.canny_high_threshold, 0, kInf, false, true);

@@ -13,6 +13,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "hidden_rooms/input_error.h"
+#include "hidden_rooms/parameter_table.h"
 #include "hidden_rooms/prediction_support.h"
 #include "hidden_rooms/structured_predictor.h"
 
@@ -20,10 +21,7 @@ namespace hidden_rooms {
 
 namespace {
 
-struct ParameterField {
-  const char* name;
-  double ThesisOptions::*field;
-};
+using ParameterField = hidden_rooms::ParameterField<ThesisOptions>;
 
 const std::vector<ParameterField>& parameterFields() {
   static const std::vector<ParameterField> fields{
@@ -59,8 +57,7 @@ void requireRange(const std::string& name, double value, double low, double high
 }
 
 void validate(const ThesisOptions& o) {
-  for (const ParameterField& f : parameterFields())
-    if (!std::isfinite(o.*(f.field))) throw InputError("parameters", std::string("parameter '") + f.name + "' is not finite");
+  requireFiniteParameters(parameterFields(), o);
   requireRange("thesis_depth", o.depth, 0, 1000, true);
   requireRange("thesis_max_candidates", o.max_candidates, 0, 20, true);
   requireRange("thesis_max_exchangeable", o.max_exchangeable, 0, 20, true);
@@ -664,26 +661,17 @@ cv::Mat1b borderRoomMask(const OccupancyGrid& map, const cv::Rect& square, const
 // ---------------------------------------------------------------------------------------------------------
 
 const std::vector<std::string>& thesisParameterNames() {
-  static const std::vector<std::string> names = [] {
-    std::vector<std::string> list;
-    for (const ParameterField& f : parameterFields()) list.push_back(f.name);
-    return list;
-  }();
+  static const std::vector<std::string> names = parameterNames(parameterFields());
   return names;
 }
 
 std::map<std::string, double> thesisParameters(const ThesisOptions& options) {
-  std::map<std::string, double> parameters;
-  for (const ParameterField& f : parameterFields()) parameters[f.name] = options.*(f.field);
-  return parameters;
+  return parameterValues(parameterFields(), options);
 }
 
 ThesisOptions thesisOptionsFromParameters(const std::map<std::string, double>& parameters) {
   ThesisOptions options;
-  for (const ParameterField& f : parameterFields()) {
-    const auto found = parameters.find(f.name);
-    if (found != parameters.end()) options.*(f.field) = found->second;
-  }
+  applyParameterValues(parameterFields(), parameters, &options);
   validate(options);
   return options;
 }
