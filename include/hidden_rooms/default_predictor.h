@@ -24,7 +24,8 @@
 // 3. The rectangle's unknown pixels connected to the door; pixels claimed by several rooms go to the nearest
 //    door.
 //
-// Parameters (config/prediction.yaml): start_search_radius and the default_* keys.
+// Parameters: start_search_radius and the default_* keys (config/prediction.yaml), and the layout's
+// (config/layout.yaml) for the grown rooms; --debug-dir receives the layout's images.
 // terms: "rectangle" (1 when the rectangle was chosen, 0 the grown room); a grown room has the thesis's terms, a
 // rectangle "width", "depth" (metres), "depth_bounded" (1 when the depth came from the map, 0 from a prior) and
 // "rotation" (degrees the map was turned).

@@ -283,10 +283,12 @@ double dominantWallAngle(const OccupancyGrid& map) {
 }
 
 std::map<std::string, double> DefaultPredictor::defaultParameters() const {
-  return {{"start_search_radius", kStartSearchRadius}, {"default_wall_gap", kWallGap},
-          {"default_max_extent", kMaxExtent},          {"default_bounded_fraction", kBoundedFraction},
-          {"default_neighbour_reach", kNeighbourReach}, {"default_min_depth", kMinDepth},
-          {"default_min_rotation", kMinRotation},       {"default_grown_area_ratio", kGrownAreaRatio}};
+  std::map<std::string, double> parameters = layoutParameters(LayoutOptions());  // for the grown rooms
+  parameters.insert({{"start_search_radius", kStartSearchRadius}, {"default_wall_gap", kWallGap},
+                     {"default_max_extent", kMaxExtent},          {"default_bounded_fraction", kBoundedFraction},
+                     {"default_neighbour_reach", kNeighbourReach}, {"default_min_depth", kMinDepth},
+                     {"default_min_rotation", kMinRotation},       {"default_grown_area_ratio", kGrownAreaRatio}});
+  return parameters;
 }
 
 namespace {
@@ -509,9 +511,12 @@ PredictionResult DefaultPredictor::predict(const PredictionRequest& request) con
   std::vector<RoomPrediction> rectangles = rectangleRooms(request, P, angle);
   // The layout's cells are axis-aligned: on a turned map only the rectangles (built on the map turned straight).
   const bool turned = std::abs(angle) * 180.0 / CV_PI >= P.min_rotation;
+  // The grown rooms: the thesis's growth with its own constants on the layout this request configures.
   PredictionRequest grown_request;
   grown_request.map = request.map;
   grown_request.doors = request.doors;
+  grown_request.debug_dir = request.debug_dir;
+  for (const std::string& name : layoutParameterNames()) grown_request.parameters[name] = values.at(name);
   std::vector<RoomPrediction> grown =
       turned ? std::vector<RoomPrediction>(rectangles.size()) : ThesisPredictor().predict(grown_request).rooms;
 
