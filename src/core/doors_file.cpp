@@ -5,8 +5,8 @@
 #include <cmath>
 #include <fstream>
 #include <set>
-#include <sstream>
 
+#include "hidden_rooms/file_io.h"
 #include "hidden_rooms/input_error.h"
 
 namespace hidden_rooms {
@@ -78,13 +78,7 @@ DoorsFile parseDoors(const std::string& yaml_text, const std::string& source) {
   return file;
 }
 
-DoorsFile loadDoors(const std::string& path) {
-  std::ifstream stream(path, std::ios::binary);
-  if (!stream) throw InputError(path, "cannot open doors file");
-  std::ostringstream text;
-  text << stream.rdbuf();
-  return parseDoors(text.str(), path);
-}
+DoorsFile loadDoors(const std::string& path) { return parseDoors(readTextFile(path, "doors file"), path); }
 
 void saveDoors(const DoorsFile& doors, const std::string& path) {
   YAML::Emitter out;

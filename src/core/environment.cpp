@@ -11,6 +11,7 @@
 #include <map>
 #include <sstream>
 
+#include "hidden_rooms/file_io.h"
 #include "hidden_rooms/input_error.h"
 
 namespace hidden_rooms {
@@ -392,11 +393,7 @@ Environment parseEnvironment(const std::string& xml_text, const std::string& sou
 }
 
 Environment loadEnvironment(const std::string& path) {
-  std::ifstream file(path, std::ios::binary);
-  if (!file) throw InputError(path, "cannot open environment file");
-  std::ostringstream text;
-  text << file.rdbuf();
-  return parseEnvironment(text.str(), path);
+  return parseEnvironment(readTextFile(path, "environment file"), path);
 }
 
 std::string environmentToXml(const Environment& environment) {

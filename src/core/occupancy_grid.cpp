@@ -9,6 +9,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "hidden_rooms/file_io.h"
 #include "hidden_rooms/input_error.h"
 
 namespace hidden_rooms {
@@ -37,14 +38,7 @@ double readFinite(const YAML::Node& root, const char* key, const std::string& so
 }
 
 MapMetadata readMetadata(const std::string& yaml_path) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(yaml_path);
-  } catch (const YAML::BadFile&) {
-    throw InputError(yaml_path, "cannot open map yaml");
-  } catch (const YAML::Exception& error) {
-    throw InputError(yaml_path, std::string("malformed YAML: ") + error.what());
-  }
+  const YAML::Node root = loadYamlFile(yaml_path, "map yaml");
   if (!root.IsMap()) throw InputError(yaml_path, "map yaml must be a mapping of keys");
 
   MapMetadata metadata;

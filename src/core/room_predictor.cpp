@@ -4,9 +4,11 @@
 
 #include <cmath>
 #include <functional>
+#include <set>
 
 #include "hidden_rooms/baselines.h"
 #include "hidden_rooms/default_predictor.h"
+#include "hidden_rooms/file_io.h"
 #include "hidden_rooms/input_error.h"
 #include "hidden_rooms/structured_predictor.h"
 #include "hidden_rooms/thesis_predictor.h"
@@ -28,17 +30,21 @@ const std::map<std::string, Factory>& registry() {
   return methods;
 }
 
+// Every parameter name some registered method reads.
+const std::set<std::string>& namesReadByAnyMethod() {
+  static const std::set<std::string> names = [] {
+    std::set<std::string> all;
+    for (const auto& [name, factory] : registry())
+      for (const auto& [parameter, value] : factory()->defaultParameters()) all.insert(parameter);
+    return all;
+  }();
+  return names;
+}
+
 }  // namespace
 
 std::map<std::string, double> loadParameterFile(const std::string& path) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    throw InputError(path, "cannot open parameters file");
-  } catch (const YAML::Exception& error) {
-    throw InputError(path, std::string("malformed YAML: ") + error.what());
-  }
+  const YAML::Node root = loadYamlFile(path, "parameters file");
   std::map<std::string, double> parameters;
   if (root.IsNull()) return parameters;
   if (!root.IsMap()) throw InputError(path, "parameters file must be a mapping of names to numbers");
@@ -65,9 +71,7 @@ std::map<std::string, double> resolveParameters(const RoomPredictor& method,
       parameters[name] = value;
       continue;
     }
-    bool read_by_another = false;
-    for (const auto& [other_name, factory] : registry()) read_by_another |= factory()->defaultParameters().count(name) > 0;
-    if (!read_by_another)
+    if (namesReadByAnyMethod().count(name) == 0)
       throw InputError("parameters", "unknown parameter '" + name + "' (no prediction method reads it)");
   }
   return parameters;
