@@ -32,6 +32,11 @@ RoomPrediction unplacedRoom(const OccupancyGrid& map, int door_id, const std::st
 // Throws InputError when the map has no cells or no known cell.
 void checkUsableMap(const OccupancyGrid& map);
 
+// For requests from outside (the predict_rooms service): throws InputError("door ID", ...) naming the first
+// door whose position lies outside the map's extent (usually a door given in another frame), and
+// InputError("doors", ...) when two doors share an id.
+void checkDoorsInsideMap(const OccupancyGrid& map, const DoorsFile& doors);
+
 // The input map completed with the predicted rooms (METHOD.md §5): each placed room's cells free, unknown
 // cells around it walled, and its door opened as a free rectangle of the door's width joining the room to the
 // explored side.
@@ -40,6 +45,10 @@ OccupancyGrid insertRooms(const OccupancyGrid& map, const DoorsFile& doors, cons
 // Label image of the map's size: k on the cells of the room predicted for the k-th door (1-based), 0 elsewhere;
 // 16-bit so that more than 255 doors fit. A cell claimed by several rooms goes to the one whose door is nearest.
 cv::Mat1w roomLabels(const OccupancyGrid& map, const DoorsFile& doors, const std::vector<RoomPrediction>& rooms);
+
+// The colour of the room with label k (1-based) in every picture and rviz overlay, BGR: hues spread by the
+// golden angle, so that neighbouring labels differ.
+cv::Vec3b roomColour(int label);
 
 // Picture for people: the map in grey, each predicted room tinted in its own colour and, when `true_labels` is
 // not empty (same labels), each true room outlined in green.

@@ -3,6 +3,7 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
@@ -34,6 +35,21 @@ struct RenderedEnvironment {
 // (joining fewer than two spaces) are drawn as wall; every other door gets a gap of `door_width`.
 RenderedEnvironment renderEnvironment(const Environment& environment, const std::set<int>& closed_door_indices,
                                       const RenderOptions& options = RenderOptions());
+
+// The walls renderEnvironment draws, as solid rectangles (metres, environment frame): every WALL segment
+// thickened to the wall thickness and extended by half of it at both ends, with a gap of `door_width` cut
+// through every wall a door in `open_door_indices` opens (both drawings of a double wall). Per door index:
+// `door_leaves` holds the wall pieces cut away for it (adding them back closes the door exactly as a closed door
+// is drawn), `door_openings` the free rectangle across its gap (both empty for doors not in the set). Throws
+// InputError for bad options or a door index that does not exist.
+struct WallGeometry {
+  double thickness = 0.0;  // metres, as drawn
+  std::vector<Polygon> walls;
+  std::vector<std::vector<Polygon>> door_leaves;
+  std::vector<Polygon> door_openings;
+};
+WallGeometry wallGeometry(const Environment& environment, const std::set<int>& open_door_indices,
+                          const RenderOptions& options = RenderOptions());
 
 // What a robot maps when the closed doors stay shut: the rendering with the room behind each closed door made
 // unknown, its walls too except where they face explored free space. `true_rooms` holds k on the free cells

@@ -24,6 +24,7 @@ constexpr double kNeighbourReach = 15.0;     // m: how far along the wall explor
 constexpr double kMinDepth = 2.0;            // m: smallest depth taken from the square prior
 constexpr double kMinRotation = 1.0;         // degrees: smaller dominant angles are not corrected
 constexpr double kGrownAreaRatio = 0.6;      // grown rooms smaller than this share of the rectangle give way
+constexpr double kStubLength = 0.3;          // m: wall stubs this long into the explored side end a room's extent
 
 // Working states of a pixel.
 constexpr uint8_t kUnknownPx = 0, kFreePx = 1, kOccupiedPx = 2;
@@ -41,7 +42,7 @@ cv::Mat1b statesOf(const OccupancyGrid& map) {
 
 struct Parameters {
   double start_search_radius, wall_gap, max_extent, bounded_fraction, neighbour_reach, min_depth, min_rotation;
-  double grown_area_ratio;
+  double grown_area_ratio, stub_length;
 };
 
 // A door in the working image: centre pixel, wall axis a and normal n (unit axis vectors, n into the unknown).
@@ -58,6 +59,7 @@ struct DoorFrame {
   bool bounded = false;
   std::vector<int> bounded_depths;
   double neighbour_depth = -1.0;
+  int depth_source = 0;  // 0 measured, 1 explored neighbours, 2 sibling doors, 3 square prior
 };
 
 class Frame {
@@ -134,6 +136,13 @@ void placeDoor(const Frame& f, double resolution, const Parameters& P, DoorFrame
   d->ok = true;
 }
 
+// Occupied pixels in column u from row v towards the explored side (decreasing v), counted up to `limit`.
+int occupiedRun(const Frame& f, const DoorFrame& d, int u, int v, int limit) {
+  int run = 0;
+  while (run < limit && f.state(f.at(d, u, v - run)) == kOccupiedPx) ++run;
+  return run;
+}
+
 // How far the room reaches along the wall in direction `sign`.
 int lateralExtent(const Frame& f, double resolution, const Parameters& P, DoorFrame* d, int sign) {
   const int max_u = static_cast<int>(P.max_extent / resolution);
@@ -145,6 +154,8 @@ int lateralExtent(const Frame& f, double resolution, const Parameters& P, DoorFr
   int band0 = d->band0, band1 = d->s0 - 1;
   const int persistence = std::max(2, static_cast<int>(std::lround(0.15 / resolution)));
   int known_run = 0;
+  const int stub_px = P.stub_length > 0.0 ? std::max(2, static_cast<int>(std::lround(P.stub_length / resolution))) : 0;
+  const int max_stub_width = std::max(2, static_cast<int>(1.0 / resolution));
   for (int k = 1; k <= max_u; ++k) {
     const int u = sign * k;
     const cv::Point behind = f.at(*d, u, d->s0 + 1);
@@ -159,6 +170,14 @@ int lateralExtent(const Frame& f, double resolution, const Parameters& P, DoorFr
       if (++known_run >= persistence) return sign * (k - known_run);
     } else {
       known_run = 0;
+    }
+    // A stub of wall leaving the door's wall into the explored side (a pillar or the end of a perpendicular
+    // wall): rooms on the other side usually end there. The room ends at the stub's middle.
+    if (stub_px > 0 && k > d->half_width + 1 && occupiedRun(f, *d, u, band0 - 1, stub_px) >= stub_px) {
+      int width = 1;
+      while (width < max_stub_width && occupiedRun(f, *d, sign * (k + width), band0 - 1, stub_px) >= stub_px)
+        ++width;
+      return sign * (k + (width - 1) / 2 - 1);  // up to the stub's middle column, exclusive
     }
     int first = std::numeric_limits<int>::max(), last = std::numeric_limits<int>::min();
     for (int v = band0 - 2; v <= band1 + 2; ++v)
@@ -287,7 +306,8 @@ std::map<std::string, double> DefaultPredictor::defaultParameters() const {
   parameters.insert({{"start_search_radius", kStartSearchRadius}, {"default_wall_gap", kWallGap},
                      {"default_max_extent", kMaxExtent},          {"default_bounded_fraction", kBoundedFraction},
                      {"default_neighbour_reach", kNeighbourReach}, {"default_min_depth", kMinDepth},
-                     {"default_min_rotation", kMinRotation},       {"default_grown_area_ratio", kGrownAreaRatio}});
+                     {"default_min_rotation", kMinRotation},       {"default_grown_area_ratio", kGrownAreaRatio},
+                     {"default_stub_length", kStubLength}});
   return parameters;
 }
 
@@ -378,13 +398,18 @@ std::vector<RoomPrediction> rectangleRooms(const PredictionRequest& request, con
     DoorFrame& d = doors[i];
     if (!d.ok || d.bounded) continue;
     double depth = neighbourDepth(f, resolution, P, d);
+    d.depth_source = 1;
     if (depth < 0) {
+      d.depth_source = 2;
       std::vector<int> sibling_depths;
       for (int j : siblings[i])
         if (doors[j].bounded) sibling_depths.push_back(doors[j].depth);
       if (!sibling_depths.empty()) depth = median(sibling_depths);
     }
-    if (depth < 0) depth = std::max(static_cast<double>(d.right - d.left + 1), P.min_depth / resolution);
+    if (depth < 0) {
+      d.depth_source = 3;
+      depth = std::max(static_cast<double>(d.right - d.left + 1), P.min_depth / resolution);
+    }
     d.depth = static_cast<int>(std::lround(depth));
   }
 
@@ -411,7 +436,11 @@ std::vector<RoomPrediction> rectangleRooms(const PredictionRequest& request, con
       };
       auto split = [&](bool cut_x, cv::Rect* ri, cv::Rect* rj) {
         const int ci = cut_x ? pi.x : pi.y, cj = cut_x ? pj.x : pj.y;
-        const int mid = (ci + cj + 1) / 2;
+        // The middle of the overlap, kept between the doors.
+        const int lo = std::max(cut_x ? ri->x : ri->y, cut_x ? rj->x : rj->y);
+        const int hi = std::min(cut_x ? ri->x + ri->width : ri->y + ri->height,
+                                cut_x ? rj->x + rj->width : rj->y + rj->height);
+        const int mid = std::clamp((lo + hi + 1) / 2, std::min(ci, cj) + 1, std::max(std::min(ci, cj) + 1, std::max(ci, cj)));
         const int big = std::numeric_limits<int>::max() / 4;
         cut(ri, ci < cj ? -big : mid, ci < cj ? mid : big, cut_x);
         cut(rj, ci < cj ? mid : -big, ci < cj ? big : mid, cut_x);
@@ -482,6 +511,8 @@ std::vector<RoomPrediction> rectangleRooms(const PredictionRequest& request, con
       room.terms["width"] = (doors[i].right - doors[i].left + 1) * resolution;
       room.terms["depth"] = doors[i].depth * resolution;
       room.terms["depth_bounded"] = doors[i].bounded ? 1.0 : 0.0;
+      room.terms["depth_source"] = doors[i].depth_source;
+      room.terms["lateral_open"] = doors[i].lateral_open ? 1.0 : 0.0;
       room.terms["rotation"] = angle * 180.0 / CV_PI;
     } else {
       room.mask = cv::Mat1b::zeros(map.cells.size());
@@ -501,10 +532,11 @@ PredictionResult DefaultPredictor::predict(const PredictionRequest& request) con
   const Parameters P{values.at("start_search_radius"),     values.at("default_wall_gap"),
                      values.at("default_max_extent"),      values.at("default_bounded_fraction"),
                      values.at("default_neighbour_reach"), values.at("default_min_depth"),
-                     values.at("default_min_rotation"),    values.at("default_grown_area_ratio")};
+                     values.at("default_min_rotation"),    values.at("default_grown_area_ratio"),
+                     values.at("default_stub_length")};
   if (P.start_search_radius <= 0.0 || P.wall_gap < 0.0 || P.max_extent <= 0.0 || P.neighbour_reach < 0.0 ||
       P.min_depth < 0.0 || P.min_rotation < 0.0 || P.bounded_fraction < 0.0 || P.bounded_fraction > 1.0 ||
-      P.grown_area_ratio < 0.0)
+      P.grown_area_ratio < 0.0 || P.stub_length < 0.0)
     throw InputError("parameters", "default_* parameters out of range");
 
   const double angle = dominantWallAngle(request.map);

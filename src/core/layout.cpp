@@ -6,9 +6,9 @@
 #include <limits>
 #include <sstream>
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "hidden_rooms/image_io.h"
 #include "hidden_rooms/input_error.h"
 #include "hidden_rooms/parameter_table.h"
 
@@ -722,13 +722,7 @@ class DebugCanvas {
 
 void writeImage(const std::string& dir, const std::string& name, const cv::Mat& image) {
   const std::string path = (std::filesystem::path(dir) / name).string();
-  bool written = false;
-  try {
-    written = cv::imwrite(path, image);
-  } catch (const cv::Exception&) {
-    written = false;
-  }
-  if (!written) throw InputError(path, "cannot write debug image");
+  hidden_rooms::writeImage(path, image);
 }
 
 void blend(cv::Mat3b* canvas, const cv::Rect& rect, const cv::Scalar& colour, double alpha) {

@@ -6,10 +6,10 @@
 #include <filesystem>
 #include <fstream>
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "hidden_rooms/file_io.h"
+#include "hidden_rooms/image_io.h"
 #include "hidden_rooms/input_error.h"
 
 namespace hidden_rooms {
@@ -161,10 +161,12 @@ OccupancyGrid loadMap(const std::string& yaml_path) {
   if (image_path.is_relative()) image_path = std::filesystem::path(yaml_path).parent_path() / image_path;
   if (!std::filesystem::is_regular_file(image_path))
     throw InputError(yaml_path, "map image '" + image_path.string() + "' does not exist");
-  const cv::Mat image = cv::imread(image_path.string(), cv::IMREAD_UNCHANGED);
-  if (image.empty())
-    throw InputError(yaml_path, "map image '" + image_path.string() + "' cannot be read as an image");
-  if (image.cols == 0 || image.rows == 0) throw InputError(yaml_path, "map image is empty");
+  cv::Mat image;
+  try {
+    image = readImage(image_path.string());
+  } catch (const InputError& error) {
+    throw InputError(yaml_path, "map image '" + image_path.string() + "' cannot be read as an image: " + error.problem());
+  }
   return gridFromImage(image, metadata);
 }
 
@@ -180,7 +182,7 @@ std::string saveMap(const OccupancyGrid& grid, const std::string& prefix) {
     }
   const std::filesystem::path yaml_path = prefix + ".yaml";
   const std::filesystem::path pgm_path = prefix + ".pgm";
-  if (!cv::imwrite(pgm_path.string(), image)) throw InputError(pgm_path.string(), "cannot write map image");
+  writeImage(pgm_path.string(), image);
 
   std::ofstream yaml(yaml_path);
   if (!yaml) throw InputError(yaml_path.string(), "cannot write map yaml");

@@ -2,7 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <limits>
+#include <set>
+#include <sstream>
 
 #include <opencv2/imgproc.hpp>
 
@@ -80,6 +83,22 @@ void checkUsableMap(const OccupancyGrid& map) {
     throw InputError("map", "resolution must be positive");
 }
 
+void checkDoorsInsideMap(const OccupancyGrid& map, const DoorsFile& doors) {
+  std::set<int> ids;
+  for (const MapDoor& door : doors.doors) {
+    if (!ids.insert(door.id).second) throw InputError("doors", "door id " + std::to_string(door.id) + " is used twice");
+    int col = 0, row = 0;
+    if (!map.cellOf(door.position, &col, &row)) {
+      std::ostringstream problem;
+      problem << std::fixed << std::setprecision(2) << "position (" << door.position.x() << ", "
+              << door.position.y() << ") is outside the map (x " << map.origin.x() << " .. "
+              << map.origin.x() + map.width() * map.resolution << ", y " << map.origin.y() << " .. "
+              << map.origin.y() + map.height() * map.resolution << " m)";
+      throw InputError("door " + std::to_string(door.id), problem.str());
+    }
+  }
+}
+
 OccupancyGrid insertRooms(const OccupancyGrid& map, const DoorsFile& doors, const std::vector<RoomPrediction>& rooms) {
   OccupancyGrid completed = map;
   cv::Mat1b all_rooms = cv::Mat1b::zeros(map.cells.size());
@@ -141,6 +160,12 @@ cv::Mat1w roomLabels(const OccupancyGrid& map, const DoorsFile& doors, const std
   return labels;
 }
 
+cv::Vec3b roomColour(int label) {
+  cv::Mat3b hsv(1, 1, cv::Vec3b(static_cast<uchar>(std::fmod(label * 137.508, 360.0) / 2), 170, 230)), bgr;
+  cv::cvtColor(hsv, bgr, cv::COLOR_HSV2BGR);
+  return bgr(0, 0);
+}
+
 cv::Mat3b renderPredictionOverlay(const OccupancyGrid& map, const cv::Mat1w& predicted_labels,
                                   const cv::Mat& true_labels) {
   cv::Mat3b overlay;
@@ -150,10 +175,8 @@ cv::Mat3b renderPredictionOverlay(const OccupancyGrid& map, const cv::Mat1w& pre
   for (int label = 1; label <= static_cast<int>(max_label); ++label) {
     const cv::Mat1b room = predicted_labels == label;
     if (cv::countNonZero(room) == 0) continue;
-    cv::Mat3b hsv(1, 1, cv::Vec3b(static_cast<uchar>(std::fmod(label * 137.508, 360.0) / 2), 170, 230)), bgr;
-    cv::cvtColor(hsv, bgr, cv::COLOR_HSV2BGR);
     cv::Mat3b tinted;
-    cv::addWeighted(overlay, 0.4, cv::Mat3b(overlay.size(), bgr(0, 0)), 0.6, 0.0, tinted);
+    cv::addWeighted(overlay, 0.4, cv::Mat3b(overlay.size(), roomColour(label)), 0.6, 0.0, tinted);
     tinted.copyTo(overlay, room);
   }
   if (!true_labels.empty()) {

@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "hidden_rooms/image_io.h"
 #include "hidden_rooms/input_error.h"
 
 namespace hidden_rooms {
@@ -65,6 +65,73 @@ void validate(const RenderOptions& options, double wall_thickness) {
 
 }  // namespace
 
+WallGeometry wallGeometry(const Environment& environment, const std::set<int>& open_door_indices,
+                          const RenderOptions& options) {
+  const double thickness =
+      options.wall_thickness.value_or(environment.wall_thickness.value_or(RenderOptions::kDefaultWallThickness));
+  validate(options, thickness);
+  for (int index : open_door_indices)
+    if (index < 0 || index >= static_cast<int>(environment.doors.size()))
+      throw InputError("render options", "open door index " + std::to_string(index) + " does not exist");
+  WallGeometry geometry;
+  geometry.thickness = thickness;
+  geometry.door_leaves.resize(environment.doors.size());
+  geometry.door_openings.resize(environment.doors.size());
+
+  // Open doors. Real floor plans often draw the wall between two spaces twice, once per space and up to
+  // kMaxDoubleWallOffset apart, with the portal on one of the two lines: the gap is cut through every wall of
+  // the joined spaces parallel to the door within that offset, and through any other wall the door lies on.
+  const std::vector<int> open_doors(open_door_indices.begin(), open_door_indices.end());
+  const double on_wall_tolerance = std::max(thickness, 2.0 * options.resolution);
+  const double cap = 0.5 * thickness;
+  std::vector<double> door_half_depth(environment.doors.size(), 0.5 * thickness + options.resolution);
+  for (size_t s = 0; s < environment.spaces.size(); ++s) {
+    for (const LineSegment& segment : environment.spaces[s].segments) {
+      const double length = (segment.b - segment.a).norm();
+      if (segment.segment_class != SegmentClass::kWall || length <= 1e-9) continue;
+      const Point2 a = segment.a, b = segment.b;
+      std::vector<std::pair<double, double>> solid{{0.0, 1.0}};  // parameter intervals along a -> b left standing
+      const Point2 direction = (b - a) / length;
+      const double wall_angle = std::atan2(direction.y(), direction.x());
+      for (int d : open_doors) {
+        const Door& door = environment.doors[d];
+        if (angleBetweenLines(wall_angle, door.wall_angle) > kSameLineAngle) continue;
+        const double t = projectionParameter(door.centre, a, b);
+        const double offset = std::abs(direction.x() * (door.centre.y() - a.y()) -
+                                       direction.y() * (door.centre.x() - a.x()));
+        const double half_cut = (0.5 * options.door_width + 0.5 * thickness) / length;
+        const bool joins_space = std::find(door.space_indices.begin(), door.space_indices.end(),
+                                           static_cast<int>(s)) != door.space_indices.end();
+        const bool on_this_wall = distanceToSegment(door.centre, a, b) <= on_wall_tolerance;
+        const bool double_wall = joins_space && offset <= kMaxDoubleWallOffset && t > -half_cut && t < 1.0 + half_cut;
+        if (!on_this_wall && !double_wall) continue;
+        door_half_depth[d] = std::max(door_half_depth[d], offset + 0.5 * thickness + options.resolution);
+        std::vector<std::pair<double, double>> remaining;
+        for (const auto& [t0, t1] : solid) {
+          if (t - half_cut > t0) remaining.emplace_back(t0, std::min(t1, t - half_cut));
+          if (t + half_cut < t1) remaining.emplace_back(std::max(t0, t + half_cut), t1);
+        }
+        solid.swap(remaining);
+        // The wall cut away (the visible gap is door_width wide: the pieces left keep their caps).
+        const double s0 = std::max(-cap, t * length - 0.5 * options.door_width);
+        const double s1 = std::min(length + cap, t * length + 0.5 * options.door_width);
+        if (s1 > s0)
+          geometry.door_leaves[d].push_back(segmentRectangle(a + s0 * direction, a + s1 * direction, cap, 0.0));
+      }
+      for (const auto& [t0, t1] : solid)
+        if (t1 > t0) geometry.walls.push_back(segmentRectangle(a + t0 * (b - a), a + t1 * (b - a), cap, cap));
+    }
+  }
+  for (int d : open_doors) {
+    const Door& door = environment.doors[d];
+    const Point2 along(std::cos(door.wall_angle), std::sin(door.wall_angle));
+    const double half = 0.5 * options.door_width;
+    geometry.door_openings[d] =
+        segmentRectangle(door.centre - half * along, door.centre + half * along, door_half_depth[d], 0.0);
+  }
+  return geometry;
+}
+
 RenderedEnvironment renderEnvironment(const Environment& environment, const std::set<int>& closed_door_indices,
                                       const RenderOptions& options) {
   const double thickness =
@@ -93,64 +160,12 @@ RenderedEnvironment renderEnvironment(const Environment& environment, const std:
     fillPolygon<uint16_t>(&result.space_labels, grid, environment.spaces[s].outline, static_cast<uint16_t>(s + 1));
   }
 
-  // Open doors. Real floor plans often draw the wall between two spaces twice, once per space and up to
-  // kMaxDoubleWallOffset apart, with the portal on one of the two lines: the gap is cut through every wall of
-  // the joined spaces parallel to the door within that offset, and through any other wall the door lies on.
-  std::vector<int> open_doors;
+  std::set<int> open_doors;
   for (size_t d = 0; d < environment.doors.size(); ++d)
-    if (isOpen(environment.doors[d], static_cast<int>(d), closed_door_indices)) open_doors.push_back(static_cast<int>(d));
-  const double on_wall_tolerance = std::max(thickness, 2.0 * resolution);
-  struct WallPiece {
-    Point2 a, b;
-    std::vector<std::pair<double, double>> solid{{0.0, 1.0}};  // parameter intervals along a -> b left standing
-  };
-  std::vector<WallPiece> walls;
-  std::vector<double> door_half_depth(environment.doors.size(), 0.5 * thickness + resolution);
-  for (size_t s = 0; s < environment.spaces.size(); ++s) {
-    for (const LineSegment& segment : environment.spaces[s].segments) {
-      const double length = (segment.b - segment.a).norm();
-      if (segment.segment_class != SegmentClass::kWall || length <= 1e-9) continue;
-      WallPiece wall{segment.a, segment.b};
-      const Point2 direction = (wall.b - wall.a) / length;
-      const double wall_angle = std::atan2(direction.y(), direction.x());
-      for (int d : open_doors) {
-        const Door& door = environment.doors[d];
-        if (angleBetweenLines(wall_angle, door.wall_angle) > kSameLineAngle) continue;
-        const double t = projectionParameter(door.centre, wall.a, wall.b);
-        const double offset = std::abs(direction.x() * (door.centre.y() - wall.a.y()) -
-                                       direction.y() * (door.centre.x() - wall.a.x()));
-        const double half_cut = (0.5 * options.door_width + 0.5 * thickness) / length;
-        const bool joins_space = std::find(door.space_indices.begin(), door.space_indices.end(),
-                                           static_cast<int>(s)) != door.space_indices.end();
-        const bool on_this_wall = distanceToSegment(door.centre, wall.a, wall.b) <= on_wall_tolerance;
-        const bool double_wall = joins_space && offset <= kMaxDoubleWallOffset && t > -half_cut && t < 1.0 + half_cut;
-        if (!on_this_wall && !double_wall) continue;
-        door_half_depth[d] = std::max(door_half_depth[d], offset + 0.5 * thickness + resolution);
-        std::vector<std::pair<double, double>> remaining;
-        for (const auto& [t0, t1] : wall.solid) {
-          if (t - half_cut > t0) remaining.emplace_back(t0, std::min(t1, t - half_cut));
-          if (t + half_cut < t1) remaining.emplace_back(std::max(t0, t + half_cut), t1);
-        }
-        wall.solid.swap(remaining);
-      }
-      walls.push_back(std::move(wall));
-    }
-  }
-  for (int d : open_doors) {
-    const Door& door = environment.doors[d];
-    const Point2 along(std::cos(door.wall_angle), std::sin(door.wall_angle));
-    const double half = 0.5 * options.door_width;
-    fillPolygon<int8_t>(&grid.cells, grid,
-                        segmentRectangle(door.centre - half * along, door.centre + half * along, door_half_depth[d], 0.0),
-                        OccupancyGrid::kFree);
-  }
-  for (const WallPiece& wall : walls)
-    for (const auto& [t0, t1] : wall.solid)
-      if (t1 > t0)
-        fillPolygon<int8_t>(&grid.cells, grid,
-                            segmentRectangle(wall.a + t0 * (wall.b - wall.a), wall.a + t1 * (wall.b - wall.a),
-                                             0.5 * thickness, 0.5 * thickness),
-                            OccupancyGrid::kOccupied);
+    if (isOpen(environment.doors[d], static_cast<int>(d), closed_door_indices)) open_doors.insert(static_cast<int>(d));
+  const WallGeometry geometry = wallGeometry(environment, open_doors, options);
+  for (const Polygon& opening : geometry.door_openings) fillPolygon<int8_t>(&grid.cells, grid, opening, OccupancyGrid::kFree);
+  for (const Polygon& wall : geometry.walls) fillPolygon<int8_t>(&grid.cells, grid, wall, OccupancyGrid::kOccupied);
   result.space_labels.setTo(0, grid.cells != OccupancyGrid::kFree);
 
   result.closed_doors.frame = "map";
@@ -234,7 +249,7 @@ void saveLabelImage(const cv::Mat1w& labels, const std::string& path) {
   cv::Mat image;
   if (max_label <= 255.0) labels.convertTo(image, CV_8U);
   else image = labels;
-  if (!cv::imwrite(path, image)) throw InputError(path, "cannot write label image");
+  writeImage(path, image);
 }
 
 }  // namespace hidden_rooms

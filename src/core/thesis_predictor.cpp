@@ -9,9 +9,9 @@
 #include <limits>
 #include <numeric>
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "hidden_rooms/image_io.h"
 #include "hidden_rooms/input_error.h"
 #include "hidden_rooms/parameter_table.h"
 #include "hidden_rooms/prediction_support.h"
@@ -869,7 +869,7 @@ PredictionResult ThesisPredictor::predict(const PredictionRequest& request) cons
     for (int y : grid.ys)
       if (y >= 0 && y < overlay.rows) cv::line(overlay, {0, y}, {overlay.cols - 1, y}, cv::Scalar(230, 200, 150), 1);
     const std::string path = request.debug_dir + "/thesis_rooms.png";
-    if (!cv::imwrite(path, overlay)) throw InputError(path, "cannot write");
+    writeImage(path, overlay);
   }
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
   return result;

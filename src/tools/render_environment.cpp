@@ -5,10 +5,10 @@
 #include <optional>
 #include <set>
 
-#include <opencv2/imgcodecs.hpp>
 
 #include "hidden_rooms/command_line.h"
 #include "hidden_rooms/environment.h"
+#include "hidden_rooms/image_io.h"
 #include "hidden_rooms/input_error.h"
 #include "hidden_rooms/render.h"
 
@@ -61,9 +61,7 @@ int run(int argc, char** argv) {
   saveLabelImage(rendered.space_labels, (out / "spaces.png").string());
   saveDoors(rendered.closed_doors, (out / "doors.yaml").string());
   if (hidden) saveLabelImage(hidden->true_rooms, (out / "true_rooms.png").string());
-  const std::string preview_path = (out / "preview.png").string();
-  if (!cv::imwrite(preview_path, renderPreview(environment, rendered)))
-    throw InputError(preview_path, "cannot write preview");
+  writeImage((out / "preview.png").string(), renderPreview(environment, rendered));
 
   std::cout << environment_path << ": " << environment.spaces.size() << " spaces, " << environment.doors.size()
             << " doors (" << closableDoors(environment).size() << " closable), "

@@ -2,14 +2,26 @@
 
 // The one place where core types and ROS messages meet.
 
+#include <map>
 #include <string>
+#include <vector>
 
 #include <hidden_rooms/ClosedDoor.h>
+#include <hidden_rooms/PredictedRoom.h>
+#include <hidden_rooms/PredictionParameter.h>
+#include <geometry_msgs/TransformStamped.h>
+#include <geometry_msgs/Twist.h>
+#include <nav_msgs/Odometry.h>
 #include <nav_msgs/OccupancyGrid.h>
 #include <ros/time.h>
+#include <sensor_msgs/LaserScan.h>
+#include <visualization_msgs/MarkerArray.h>
 
 #include "hidden_rooms/doors_file.h"
+#include "hidden_rooms/layout.h"
 #include "hidden_rooms/occupancy_grid.h"
+#include "hidden_rooms/room_predictor.h"
+#include "hidden_rooms/simulation.h"
 
 namespace hidden_rooms {
 
@@ -21,5 +33,47 @@ OccupancyGrid fromRos(const nav_msgs::OccupancyGrid& message);
 
 hidden_rooms::ClosedDoor toRos(const MapDoor& door);
 MapDoor fromRos(const hidden_rooms::ClosedDoor& message);
+
+// Doors of a request, in `frame`. Throws InputError naming a bad door (non-finite, bad width or orientation).
+DoorsFile fromRos(const std::vector<hidden_rooms::ClosedDoor>& messages, const std::string& frame);
+std::vector<hidden_rooms::ClosedDoor> toRos(const DoorsFile& doors);
+
+// Parameter overrides. Throws InputError("parameters", ...) for an empty or repeated name or a non-finite value.
+std::map<std::string, double> fromRos(const std::vector<hidden_rooms::PredictionParameter>& messages);
+std::vector<hidden_rooms::PredictionParameter> toRos(const std::map<std::string, double>& parameters);
+
+// The message of the room predicted for the door with 1-based position `label` in the request: status, polygon,
+// area, score ("score" term, NaN without one), terms, and the mask cropped to the room's bounding box (0 on its
+// cells, -1 elsewhere) in `map`'s cell grid.
+hidden_rooms::PredictedRoom toRos(const RoomPrediction& room, int label, const OccupancyGrid& map,
+                                  const std::string& frame_id, const ros::Time& stamp);
+// The room back with its mask at the map's size (255 on its cells). Throws InputError when the mask does not lie
+// on the map's cell grid or term names and values differ in length.
+RoomPrediction fromRos(const hidden_rooms::PredictedRoom& message, const OccupancyGrid& map);
+
+// rviz overlays of a prediction, in `frame_id`: a DELETEALL marker first (so that fewer rooms than last time
+// leave nothing behind), then per predicted room a filled area (namespace "rooms", the cells of its label in
+// `labels`, colour of roomColour()), its outline ("outlines"), a text with door id and area ("labels"); every
+// door as a thick line across its width ("doors": red when its room is predicted, grey when not placed).
+visualization_msgs::MarkerArray toMarkers(const OccupancyGrid& map, const DoorsFile& doors,
+                                          const std::vector<RoomPrediction>& rooms, const cv::Mat1w& labels,
+                                          const std::string& frame_id, const ros::Time& stamp);
+// Debug overlays of the layout analysis: its extended lines ("debug_extended_lines": walls blue, door-pair lines
+// orange, boundary lines grey) and its cells ("debug_in_out_cells": IN cells green, OUT cells red, translucent).
+visualization_msgs::MarkerArray toDebugMarkers(const OccupancyGrid& map, const Layout& layout,
+                                               const std::string& frame_id, const ros::Time& stamp);
+
+// Simulator. A velocity command as it came (non-finite values pass: Simulation::setCommand rejects them).
+VelocityCommand fromRos(const geometry_msgs::Twist& message);
+// A scan of `laser` (ranges per beam, metres) in `frame_id`; scan_time = the laser's period.
+sensor_msgs::LaserScan toRos(const std::vector<float>& ranges, const LaserGeometry& laser, double min_range,
+                             double scan_time, const std::string& frame_id, const ros::Time& stamp);
+// Pose of `child_frame_id` in `frame_id` with its velocity (base_link frame: linear x, angular z).
+nav_msgs::Odometry toRos(const Pose2& pose, const VelocityCommand& velocity, const std::string& frame_id,
+                         const std::string& child_frame_id, const ros::Time& stamp);
+// The transform frame_id -> child_frame_id that places the child at `pose`.
+geometry_msgs::TransformStamped toTransform(const Pose2& pose, const std::string& frame_id,
+                                            const std::string& child_frame_id, const ros::Time& stamp);
+Pose2 fromRos(const geometry_msgs::Pose& pose);
 
 }  // namespace hidden_rooms

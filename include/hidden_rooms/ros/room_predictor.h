@@ -1,0 +1,58 @@
+#pragma once
+
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include <hidden_rooms/PredictRooms.h>
+#include <nav_msgs/OccupancyGrid.h>
+#include <ros/ros.h>
+
+#include "hidden_rooms/doors_file.h"
+#include "hidden_rooms/occupancy_grid.h"
+#include "hidden_rooms/room_predictor.h"
+
+namespace hidden_rooms {
+
+// Parameters of the room_predictor node (all private, ~name).
+struct RoomPredictorOptions {
+  std::string method = "default";  // method used when a request names none (and by ~predict_on_map)
+  std::string closed_doors_file;   // doors.yaml: the doors of a request that gives none; "" = none
+  std::string params_file;         // flat `name: number` overrides applied to every request; "" = none
+  bool predict_on_map = false;     // predict the file's doors again whenever a new map arrives on `map`
+  bool publish_debug = false;      // add the layout analysis to predicted_rooms (extended lines, IN/OUT cells)
+  std::string frame_id = "map";    // frame of outputs when the map message has an empty header.frame_id
+};
+
+// Reads the options from the private node handle. Throws InputError for ~predict_on_map without doors.
+RoomPredictorOptions readRoomPredictorOptions(const ros::NodeHandle& private_nh);
+
+// Serves `predict_rooms` (PredictRooms) over the latest map of `map` or the request's own map, and publishes
+// each prediction, latched, as `predicted_map` (the completed map) and `predicted_rooms` (rviz markers).
+class RoomPredictorNode {
+ public:
+  // Checks the method and loads the doors and parameters files (throws InputError naming a bad one); does not
+  // wait for anything.
+  RoomPredictorNode(ros::NodeHandle nh, const RoomPredictorOptions& options);
+
+  // The service: never throws; every failure is success = false with a message.
+  bool predictRooms(PredictRooms::Request& request, PredictRooms::Response& response);
+
+ private:
+  void receiveMap(const nav_msgs::OccupancyGrid::ConstPtr& map);
+  // Predicts and publishes; throws InputError for an unusable request.
+  void predict(const PredictRooms::Request& request, PredictRooms::Response* response);
+
+  RoomPredictorOptions options_;
+  std::optional<DoorsFile> default_doors_;
+  std::map<std::string, double> file_parameters_;
+  nav_msgs::OccupancyGrid::ConstPtr latest_map_;
+  std::string map_topic_;
+  ros::Subscriber map_subscriber_;
+  ros::Publisher predicted_map_publisher_;
+  ros::Publisher markers_publisher_;
+  ros::ServiceServer service_;
+};
+
+}  // namespace hidden_rooms

@@ -1,0 +1,86 @@
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <geometry_msgs/Twist.h>
+#include <hidden_rooms/SetDoor.h>
+#include <ros/ros.h>
+#include <rosgraph_msgs/Clock.h>
+#include <std_srvs/Trigger.h>
+#include <tf2_ros/static_transform_broadcaster.h>
+#include <tf2_ros/transform_broadcaster.h>
+
+#include "hidden_rooms/render.h"
+#include "hidden_rooms/simulation.h"
+
+namespace hidden_rooms {
+
+// Parameters of the simulator node (all private, ~name; see README.md and config/simulation.yaml).
+struct SimulatorOptions {
+  std::string environment;   // environment XML (set this, ~map_file or ~bitmap)
+  std::string map_file;      // map_server yaml of a bitmap world
+  std::string bitmap;        // Stage-style image (dark = wall), with ~bitmap_resolution
+  double bitmap_resolution = 0.05;  // metres per pixel of ~bitmap; its lower-left corner is the world origin
+  std::string closed_doors;  // environment doors closed at start: numbers or ids, comma-separated, or "all"
+  RenderOptions render;      // door_width, wall_thickness (the world's walls as rendered)
+  SimulationOptions simulation;
+  double realtime_factor = 1.0;   // simulated seconds per wall-clock second; 0 = as fast as possible
+  double laser_rate = 10.0;       // Hz of simulated time
+  double odom_rate = 20.0;        // Hz of simulated time (odom, base_pose_ground_truth, tf odom -> base_link)
+  double clock_rate = 100.0;      // Hz of simulated time (/clock); at most once per physics step
+  double duration = 0.0;          // simulated seconds after which the node exits; 0 = run until shut down
+  std::string world_frame = "world";
+  std::string odom_frame = "odom";
+  std::string base_frame = "base_link";
+  std::string laser_frame = "base_laser_link";
+  bool publish_world_to_odom = false;  // tf world -> odom at the start pose (for viewing without SLAM)
+};
+
+// Reads the options from the private node handle. Throws InputError for a bad value or a world source missing
+// or given twice.
+SimulatorOptions readSimulatorOptions(const ros::NodeHandle& private_nh);
+
+// Stage/stage_ros's job on the core's Box2D simulation: steps the world with a fixed physics step at
+// `realtime_factor`, publishes /clock, base_scan, odom, base_pose_ground_truth and tf, follows cmd_vel, and
+// serves reset and set_door.
+class Simulator {
+ public:
+  // Loads the world and builds the simulation (throws InputError when it cannot); does not wait for anything.
+  Simulator(ros::NodeHandle nh, const SimulatorOptions& options);
+
+  // Steps and publishes until ROS shuts down or ~duration is reached, pacing to realtime_factor.
+  void run();
+  // One physics step and whatever is due after it (publications at their rates). Callbacks are not handled.
+  void step();
+  const Simulation& simulation() const { return *simulation_; }
+  ros::Time now() const;
+
+ private:
+  void onCommand(const geometry_msgs::Twist::ConstPtr& command);
+  bool onReset(std_srvs::Trigger::Request& request, std_srvs::Trigger::Response& response);
+  bool onSetDoor(hidden_rooms::SetDoor::Request& request, hidden_rooms::SetDoor::Response& response);
+  void publishClock();
+  void publishScan();
+  void publishOdometry();
+
+  SimulatorOptions options_;
+  std::unique_ptr<Simulation> simulation_;
+  uint64_t laser_period_steps_ = 1;
+  uint64_t odom_period_steps_ = 1;
+  uint64_t clock_period_steps_ = 1;
+  std::vector<float> ranges_;
+  ros::Publisher clock_publisher_;
+  ros::Publisher scan_publisher_;
+  ros::Publisher odom_publisher_;
+  ros::Publisher ground_truth_publisher_;
+  ros::Publisher footprint_publisher_;
+  ros::Subscriber command_subscriber_;
+  ros::ServiceServer reset_service_;
+  ros::ServiceServer set_door_service_;
+  tf2_ros::TransformBroadcaster tf_broadcaster_;
+  tf2_ros::StaticTransformBroadcaster static_tf_broadcaster_;
+};
+
+}  // namespace hidden_rooms

@@ -1,0 +1,129 @@
+#include "hidden_rooms/ros/room_predictor.h"
+
+#include <cstdio>
+
+#include <visualization_msgs/MarkerArray.h>
+
+#include "hidden_rooms/input_error.h"
+#include "hidden_rooms/layout.h"
+#include "hidden_rooms/prediction_support.h"
+#include "hidden_rooms/ros/conversions.h"
+
+namespace hidden_rooms {
+
+RoomPredictorOptions readRoomPredictorOptions(const ros::NodeHandle& private_nh) {
+  RoomPredictorOptions options;
+  private_nh.param("method", options.method, options.method);
+  private_nh.param("closed_doors_file", options.closed_doors_file, options.closed_doors_file);
+  private_nh.param("params_file", options.params_file, options.params_file);
+  private_nh.param("predict_on_map", options.predict_on_map, options.predict_on_map);
+  private_nh.param("publish_debug", options.publish_debug, options.publish_debug);
+  private_nh.param("frame_id", options.frame_id, options.frame_id);
+  if (options.predict_on_map && options.closed_doors_file.empty())
+    throw InputError(private_nh.getNamespace(), "~predict_on_map needs ~closed_doors_file");
+  return options;
+}
+
+RoomPredictorNode::RoomPredictorNode(ros::NodeHandle nh, const RoomPredictorOptions& options) : options_(options) {
+  // A bad method, doors file or parameters file stops the node here, not at the first request.
+  const std::unique_ptr<RoomPredictor> method = makeRoomPredictor(options_.method);
+  if (!options_.closed_doors_file.empty()) default_doors_ = loadDoors(options_.closed_doors_file);
+  if (!options_.params_file.empty()) {
+    file_parameters_ = loadParameterFile(options_.params_file);
+    resolveParameters(*method, file_parameters_);  // throws for a name no method reads
+  }
+  map_topic_ = nh.resolveName("map");
+  predicted_map_publisher_ = nh.advertise<nav_msgs::OccupancyGrid>("predicted_map", 1, true);
+  markers_publisher_ = nh.advertise<visualization_msgs::MarkerArray>("predicted_rooms", 1, true);
+  service_ = nh.advertiseService("predict_rooms", &RoomPredictorNode::predictRooms, this);
+  map_subscriber_ = nh.subscribe("map", 1, &RoomPredictorNode::receiveMap, this);
+}
+
+void RoomPredictorNode::receiveMap(const nav_msgs::OccupancyGrid::ConstPtr& map) {
+  latest_map_ = map;
+  if (!options_.predict_on_map) return;
+  PredictRooms::Request request;  // the configured doors and method over this map
+  PredictRooms::Response response;
+  predictRooms(request, response);
+  if (response.success)
+    ROS_INFO("room_predictor: new map: %s", response.message.c_str());
+  else
+    ROS_WARN("room_predictor: new map: %s", response.message.c_str());
+}
+
+bool RoomPredictorNode::predictRooms(PredictRooms::Request& request, PredictRooms::Response& response) {
+  response = PredictRooms::Response();
+  try {
+    predict(request, &response);
+  } catch (const std::exception& error) {  // InputError: a bad request; anything else: a bug, reported too
+    response = PredictRooms::Response();
+    response.success = false;
+    response.message = error.what();
+  }
+  return true;
+}
+
+void RoomPredictorNode::predict(const PredictRooms::Request& request, PredictRooms::Response* response) {
+  const bool own_map = request.map.info.width > 0 && request.map.info.height > 0;
+  if (!own_map && latest_map_ == nullptr)
+    throw InputError("map", "the request has no map and none was received on " + map_topic_ + " yet");
+  const nav_msgs::OccupancyGrid& map_message = own_map ? request.map : *latest_map_;
+  const std::string frame = map_message.header.frame_id.empty() ? options_.frame_id : map_message.header.frame_id;
+
+  PredictionRequest core;
+  core.map = fromRos(map_message);
+  checkUsableMap(core.map);
+  if (!request.doors.empty()) {
+    core.doors = fromRos(request.doors, frame);
+  } else if (default_doors_) {
+    core.doors = *default_doors_;
+    core.doors.frame = frame;
+  } else {
+    throw InputError("doors", "the request has no doors and the node has no ~closed_doors_file");
+  }
+  if (core.doors.doors.empty()) throw InputError("doors", "no closed doors to predict");
+  checkDoorsInsideMap(core.map, core.doors);
+  core.parameters = file_parameters_;
+  for (const auto& [name, value] : fromRos(request.parameters)) core.parameters[name] = value;
+  const std::string method = request.method.empty() ? options_.method : request.method;
+  const std::unique_ptr<RoomPredictor> predictor = makeRoomPredictor(method);
+
+  const PredictionResult result = predictor->predict(core);
+
+  const ros::Time stamp = ros::Time::now();
+  const OccupancyGrid completed = insertRooms(core.map, core.doors, result.rooms);
+  const cv::Mat1w labels = roomLabels(core.map, core.doors, result.rooms);
+  std::string not_placed;
+  response->rooms.reserve(result.rooms.size());
+  int placed = 0;
+  for (size_t k = 0; k < result.rooms.size(); ++k) {
+    const RoomPrediction& room = result.rooms[k];
+    response->rooms.push_back(toRos(room, static_cast<int>(k) + 1, core.map, frame, stamp));
+    if (room.placed)
+      ++placed;
+    else
+      not_placed += "; door " + std::to_string(room.door_id) + " not placed: " + room.problem;
+  }
+  response->success = true;
+  response->method = method;
+  response->computation_time = result.seconds;
+  response->completed_map = toRos(completed, frame, stamp);
+  response->completed_map.info.map_load_time = map_message.info.map_load_time;
+  char summary[160];
+  std::snprintf(summary, sizeof(summary), "predicted %d of %d rooms in %.3f s by %s", placed,
+                static_cast<int>(result.rooms.size()), result.seconds, method.c_str());
+  response->message = summary + not_placed;
+
+  predicted_map_publisher_.publish(response->completed_map);
+  visualization_msgs::MarkerArray markers = toMarkers(core.map, core.doors, result.rooms, labels, frame, stamp);
+  if (options_.publish_debug) {
+    LayoutOptions layout_options;
+    applyLayoutParameters(core.parameters, &layout_options);
+    const Layout layout = analyzeLayout(core.map, core.doors.doors, layout_options);
+    const visualization_msgs::MarkerArray debug = toDebugMarkers(core.map, layout, frame, stamp);
+    markers.markers.insert(markers.markers.end(), debug.markers.begin(), debug.markers.end());
+  }
+  markers_publisher_.publish(markers);
+}
+
+}  // namespace hidden_rooms
