@@ -21,13 +21,15 @@ PACKAGES=(
   libnav-msgs-dev python3-nav-msgs libsensor-msgs-dev python3-sensor-msgs libgeometry-msgs-dev
   python3-geometry-msgs libvisualization-msgs-dev python3-visualization-msgs libstd-srvs-dev python3-std-srvs
   libros-rosgraph-msgs-dev python3-rosgraph-msgs
-  ros-message-generation ros-message-runtime librosbag-dev librostest-dev rviz librviz-dev
+  ros-message-generation ros-message-runtime librosbag-dev librostest-dev rviz librviz-dev libtf2-msgs-dev libroslib-dev
   # algorithms and files
   libmrpt-slam-dev libmrpt-maps-dev libmrpt-nav-dev libmrpt-ros1bridge-dev libbox2d-dev liboctomap-dev
   libopencv-dev libeigen3-dev libpng-dev libtinyxml2-dev libyaml-cpp-dev libboost-program-options-dev
   # tests and scripts
   libgtest-dev googletest python3-nose python3-yaml python3-numpy python3-matplotlib python3-tqdm
   python3-opencv xvfb time
+  # batch analysis: the Python module's install (setuptools) and the Dask cluster option
+  python3-setuptools python3-distributed
 )
 
 missing=()

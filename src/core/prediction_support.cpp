@@ -147,9 +147,12 @@ cv::Mat1w roomLabels(const OccupancyGrid& map, const DoorsFile& doors, const std
   cv::Mat1f door_distance(map.cells.size(), std::numeric_limits<float>::infinity());
   for (size_t k = 0; k < rooms.size() && k < doors.doors.size(); ++k) {
     if (!rooms[k].placed) continue;
+    // Only the mask's bounding box is scanned: rooms are small against the map.
+    const cv::Rect box = cv::boundingRect(rooms[k].mask);
     std::vector<cv::Point> cells;
-    cv::findNonZero(rooms[k].mask, cells);
-    for (const cv::Point& cell : cells) {
+    if (box.area() > 0) cv::findNonZero(rooms[k].mask(box), cells);
+    for (cv::Point cell : cells) {
+      cell += box.tl();
       const float distance = static_cast<float>((map.cellCentre(cell.x, cell.y) - doors.doors[k].position).norm());
       if (distance < door_distance(cell)) {
         door_distance(cell) = distance;

@@ -185,6 +185,7 @@ RenderedEnvironment renderEnvironment(const Environment& environment, const std:
 HiddenRoomsCase hideClosedRooms(const Environment& environment, const RenderedEnvironment& rendered) {
   HiddenRoomsCase hidden;
   hidden.map = rendered.map;
+  hidden.map.cells = rendered.map.cells.clone();  // the caller's map stays as it is
   hidden.closed_doors = rendered.closed_doors;
   hidden.true_rooms = cv::Mat1w::zeros(rendered.map.cells.size());
   cv::Mat1b hidden_free = cv::Mat1b::zeros(rendered.map.cells.size());

@@ -413,4 +413,42 @@ Pose2 fromRos(const geometry_msgs::Pose& pose) {
           std::atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))};
 }
 
+RangeScan fromRos(const sensor_msgs::LaserScan& message, const Pose2& sensor_pose) {
+  if (message.ranges.empty()) throw InputError("scan", "has no beams");
+  if (!std::isfinite(message.angle_min) || !std::isfinite(message.angle_increment) || message.angle_increment == 0.0f)
+    throw InputError("scan", "non-finite or zero angle increment");
+  RangeScan scan;
+  scan.angle_min = message.angle_min;
+  scan.angle_increment = message.angle_increment;
+  scan.range_min = message.range_min;
+  scan.range_max = message.range_max;
+  scan.ranges = message.ranges;
+  scan.sensor_pose = sensor_pose;
+  return scan;
+}
+
+Pose2 fromRos(const geometry_msgs::Transform& transform) {
+  geometry_msgs::Pose pose;
+  pose.position.x = transform.translation.x;
+  pose.position.y = transform.translation.y;
+  pose.orientation = transform.rotation;
+  return fromRos(pose);
+}
+
+geometry_msgs::PoseArray toRos(const std::vector<RbpfParticle>& particles, const std::string& frame_id,
+                               const ros::Time& stamp) {
+  geometry_msgs::PoseArray message;
+  message.header.frame_id = frame_id;
+  message.header.stamp = stamp;
+  for (const RbpfParticle& particle : particles) {
+    geometry_msgs::Pose pose;
+    pose.position.x = particle.pose.x;
+    pose.position.y = particle.pose.y;
+    pose.orientation.z = std::sin(0.5 * particle.pose.yaw);
+    pose.orientation.w = std::cos(0.5 * particle.pose.yaw);
+    message.poses.push_back(pose);
+  }
+  return message;
+}
+
 }  // namespace hidden_rooms

@@ -13,6 +13,7 @@
 #include "hidden_rooms/input_error.h"
 #include "hidden_rooms/occupancy_grid.h"
 #include "hidden_rooms/simulation.h"
+#include "hidden_rooms/wander_driver.h"
 
 namespace po = boost::program_options;
 using namespace hidden_rooms;
@@ -29,29 +30,6 @@ double percentile(std::vector<float> values, double fraction) {
   return values[std::min(values.size() - 1, static_cast<size_t>(fraction * values.size()))];
 }
 
-// The scripted drive: forward, steering towards the more open side, turning in place (one way until the way
-// ahead is clear) when something is close ahead.
-class ScriptedDriver {
- public:
-  VelocityCommand next(const std::vector<float>& ranges, const LaserGeometry& laser) {
-    double ahead = laser.max_range, left = 0.0, right = 0.0;
-    for (int k = 0; k < laser.beams; ++k) {
-      const double angle = laser.angle_min + k * laser.angle_increment;
-      if (std::abs(angle) < 0.45) ahead = std::min(ahead, static_cast<double>(ranges[k]));
-      if (angle > 0.3 && angle < 1.6) left += std::min(ranges[k], 5.0f);
-      if (angle < -0.3 && angle > -1.6) right += std::min(ranges[k], 5.0f);
-    }
-    if (turning_ != 0 && ahead > 1.5) turning_ = 0;
-    if (turning_ == 0 && ahead < 0.9) turning_ = left >= right ? 1 : -1;
-    if (turning_ != 0) return {0.0, 1.2 * turning_};
-    const double balance = (left - right) / std::max(left + right, 1.0);
-    return {std::min(0.7, 0.35 * ahead), std::clamp(2.0 * balance, -0.6, 0.6)};
-  }
-
- private:
-  int turning_ = 0;
-};
-
 struct RunResult {
   double wall_seconds = 0.0;
   double distance = 0.0;
@@ -66,7 +44,7 @@ RunResult runDrive(Simulation* simulation, double sim_seconds, double laser_rate
   const int laser_period = std::max(1, static_cast<int>(std::lround(1.0 / (laser_rate * dt))));
   const int steps = static_cast<int>(std::lround(sim_seconds / dt));
   std::vector<float> ranges;
-  ScriptedDriver driver;
+  WanderDriver driver;
   Clock::duration excluded{0};
   const Clock::time_point start = Clock::now();
   Pose2 last = simulation->truePose();

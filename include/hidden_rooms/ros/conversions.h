@@ -9,6 +9,7 @@
 #include <hidden_rooms/ClosedDoor.h>
 #include <hidden_rooms/PredictedRoom.h>
 #include <hidden_rooms/PredictionParameter.h>
+#include <geometry_msgs/PoseArray.h>
 #include <geometry_msgs/TransformStamped.h>
 #include <geometry_msgs/Twist.h>
 #include <nav_msgs/Odometry.h>
@@ -20,6 +21,8 @@
 #include "hidden_rooms/doors_file.h"
 #include "hidden_rooms/layout.h"
 #include "hidden_rooms/occupancy_grid.h"
+#include "hidden_rooms/range_scan.h"
+#include "hidden_rooms/rbpf_mapper.h"
 #include "hidden_rooms/room_predictor.h"
 #include "hidden_rooms/simulation.h"
 
@@ -75,5 +78,14 @@ nav_msgs::Odometry toRos(const Pose2& pose, const VelocityCommand& velocity, con
 geometry_msgs::TransformStamped toTransform(const Pose2& pose, const std::string& frame_id,
                                             const std::string& child_frame_id, const ros::Time& stamp);
 Pose2 fromRos(const geometry_msgs::Pose& pose);
+
+// Mapper. A scan as the core's mapper takes it, with the pose of its frame in base_link (`sensor_pose`). Throws
+// InputError for a scan without beams or with a non-finite or zero angle increment.
+RangeScan fromRos(const sensor_msgs::LaserScan& message, const Pose2& sensor_pose);
+// The planar part of a transform (translation x, y and the yaw of its rotation).
+Pose2 fromRos(const geometry_msgs::Transform& transform);
+// The particles' poses in `frame_id` (weights are not part of the message).
+geometry_msgs::PoseArray toRos(const std::vector<RbpfParticle>& particles, const std::string& frame_id,
+                               const ros::Time& stamp);
 
 }  // namespace hidden_rooms

@@ -1,0 +1,77 @@
+#pragma once
+
+#include <deque>
+#include <memory>
+#include <string>
+
+#include <hidden_rooms/SaveMap.h>
+#include <ros/ros.h>
+#include <sensor_msgs/LaserScan.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_broadcaster.h>
+#include <tf2_ros/transform_listener.h>
+
+#include "hidden_rooms/rbpf_mapper.h"
+
+namespace hidden_rooms {
+
+// Parameters of the mapper node (all private, ~name; see README.md and config/mapper.yaml).
+struct MapperOptions {
+  RbpfMapperOptions rbpf;             // ~config_file (MRPT ini), ~seed
+  std::string scan_topic = "base_scan";
+  std::string map_frame = "map";
+  std::string odom_frame = "odom";
+  std::string base_frame = "base_link";
+  double map_update_interval = 2.0;   // seconds of ROS time between map publications (and on the first scan)
+  double tf_publish_rate = 20.0;      // Hz (wall-clock timer on ROS time) of map -> odom; 0 = after each scan
+  double transform_tolerance = 0.1;   // seconds map -> odom is stamped ahead (as gmapping / amcl do)
+  double tf_wait = 0.5;               // seconds a scan may wait for odom -> base_link at its stamp before it is dropped
+  bool publish_particles = true;      // publish `particles` (geometry_msgs/PoseArray)
+};
+
+// Reads the options from the private node handle. Throws InputError for a bad value or a missing ~config_file.
+MapperOptions readMapperOptions(const ros::NodeHandle& private_nh);
+
+// SLAM node over the core's RbpfMapper: each scan of `scan_topic` with the odometry (tf odom -> base_link at the
+// scan's stamp) goes to MRPT's RBPF; publishes the map (latched), map_metadata, the particles and tf
+// map -> odom, and serves save_map.
+class Mapper {
+ public:
+  // Loads the MRPT options (throws InputError when it cannot); does not wait for anything.
+  Mapper(ros::NodeHandle nh, const MapperOptions& options);
+
+  const RbpfMapper& mapper() const { return *mapper_; }
+  // Scans given to the filter / dropped because their odometry never arrived.
+  int scansProcessed() const { return processed_; }
+  int scansDropped() const { return dropped_; }
+
+ private:
+  void onScan(const sensor_msgs::LaserScan::ConstPtr& scan);
+  void processPending();
+  bool process(const sensor_msgs::LaserScan& scan);
+  void publishMap(const ros::Time& stamp);
+  void publishTransform(const ros::Time& stamp);
+  void onTimer(const ros::TimerEvent& event);
+  bool onSaveMap(hidden_rooms::SaveMap::Request& request, hidden_rooms::SaveMap::Response& response);
+
+  MapperOptions options_;
+  std::unique_ptr<RbpfMapper> mapper_;
+  tf2_ros::Buffer tf_buffer_;
+  tf2_ros::TransformListener tf_listener_;
+  tf2_ros::TransformBroadcaster tf_broadcaster_;
+  std::deque<sensor_msgs::LaserScan::ConstPtr> pending_;
+  ros::Time last_map_stamp_;
+  ros::Time last_scan_stamp_;
+  ros::Time last_tf_stamp_;
+  bool map_published_ = false;
+  int processed_ = 0;
+  int dropped_ = 0;
+  ros::Subscriber scan_subscriber_;
+  ros::Publisher map_publisher_;
+  ros::Publisher metadata_publisher_;
+  ros::Publisher particles_publisher_;
+  ros::ServiceServer save_service_;
+  ros::Timer tf_timer_;
+};
+
+}  // namespace hidden_rooms

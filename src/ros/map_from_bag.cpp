@@ -1,0 +1,235 @@
+// map_from_bag BAG --out PREFIX: the mapper's SLAM straight from a bag's scans and tf, as fast as the CPU allows
+// (rosbag C++ API, no roscore). Optionally scores the map against an environment's rendered ground truth.
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <deque>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <boost/program_options.hpp>
+#include <nav_msgs/Odometry.h>
+#include <ros/package.h>
+#include <rosbag/bag.h>
+#include <rosbag/view.h>
+#include <sensor_msgs/LaserScan.h>
+#include <tf2/buffer_core.h>
+#include <tf2/exceptions.h>
+#include <tf2_msgs/TFMessage.h>
+
+#include "hidden_rooms/command_line.h"
+#include "hidden_rooms/environment.h"
+#include "hidden_rooms/input_error.h"
+#include "hidden_rooms/map_quality.h"
+#include "hidden_rooms/rbpf_mapper.h"
+#include "hidden_rooms/render.h"
+#include "hidden_rooms/ros/conversions.h"
+
+namespace po = boost::program_options;
+using hidden_rooms::InputError;
+using hidden_rooms::Pose2;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
+
+struct TimedPose {
+  double time = 0.0;
+  Pose2 pose;
+};
+
+// The pose at `time` interpolated between recorded poses (clamped at the ends).
+Pose2 interpolate(const std::vector<TimedPose>& poses, double time) {
+  auto after = std::lower_bound(poses.begin(), poses.end(), time,
+                                [](const TimedPose& p, double t) { return p.time < t; });
+  if (after == poses.begin()) return poses.front().pose;
+  if (after == poses.end()) return poses.back().pose;
+  const TimedPose& a = *(after - 1);
+  const TimedPose& b = *after;
+  const double f = b.time > a.time ? (time - a.time) / (b.time - a.time) : 0.0;
+  const double dyaw = std::atan2(std::sin(b.pose.yaw - a.pose.yaw), std::cos(b.pose.yaw - a.pose.yaw));
+  return {a.pose.x + f * (b.pose.x - a.pose.x), a.pose.y + f * (b.pose.y - a.pose.y), a.pose.yaw + f * dyaw};
+}
+
+std::string defaultConfig() {
+  const std::string package = ros::package::getPath("hidden_rooms");
+  return package.empty() ? std::string() : package + "/config/rbpf.ini";
+}
+
+int run(int argc, char** argv) {
+  std::string bag_path, prefix, config, scan_topic, odom_frame, base_frame, environment_path, closed, metrics_path,
+      truth_topic;
+  int seed = 0;
+  bool quiet = false;
+  po::options_description options("Options");
+  options.add_options()
+      ("bag", po::value(&bag_path)->required(), "input bag")
+      ("out", po::value(&prefix)->required(), "output prefix: writes PREFIX.yaml and PREFIX.pgm")
+      ("config", po::value(&config), "MRPT ini (default: the package's config/rbpf.ini)")
+      ("seed", po::value(&seed)->default_value(0), "random seed of the filter")
+      ("scan-topic", po::value(&scan_topic)->default_value("base_scan"), "sensor_msgs/LaserScan topic")
+      ("odom-frame", po::value(&odom_frame)->default_value("odom"), "odometry frame in /tf")
+      ("base-frame", po::value(&base_frame)->default_value("base_link"), "robot frame in /tf")
+      ("environment", po::value(&environment_path), "score the map against this environment XML's rendering")
+      ("closed-doors", po::value(&closed)->default_value(""), "with --environment: doors closed in the run")
+      ("truth-topic", po::value(&truth_topic)->default_value("base_pose_ground_truth"),
+       "with --environment: nav_msgs/Odometry of the true pose in the world frame")
+      ("metrics", po::value(&metrics_path), "with --environment: also write the figures to this YAML file")
+      ("quiet", po::bool_switch(&quiet), "no progress line");
+  po::positional_options_description positional;
+  positional.add("bag", 1);
+  po::variables_map values;
+  if (!hidden_rooms::parseCommandLine(
+          argc, argv,
+          "Usage: map_from_bag BAG --out PREFIX [--config rbpf.ini] [--seed N] [--environment ENV.xml [--metrics F.yaml]]\n"
+          "Builds the mapper's map (MRPT RBPF) from the bag's scans and tf odom -> base_link, as fast as the CPU\n"
+          "allows, and writes it as map_server files. With --environment also prints map quality and trajectory\n"
+          "error against the rendered ground truth (true poses from --truth-topic).",
+          options, positional, &values))
+    return hidden_rooms::kExitOk;
+  if (seed < 0) throw InputError("--seed", "must be zero or positive");
+  if (config.empty()) config = defaultConfig();
+  if (config.empty()) throw InputError("--config", "not given and the package's config/rbpf.ini was not found");
+  if (!metrics_path.empty() && environment_path.empty()) throw InputError("--metrics", "needs --environment");
+
+  // Inputs first: nothing is written on bad input.
+  hidden_rooms::RenderedEnvironment truth;
+  if (!environment_path.empty()) {
+    const hidden_rooms::Environment environment = hidden_rooms::loadEnvironment(environment_path);
+    truth = hidden_rooms::renderEnvironment(environment,
+                                            hidden_rooms::parseDoorSelection(environment, closed, "--closed-doors"));
+  }
+  hidden_rooms::RbpfMapperOptions mapper_options;
+  mapper_options.config_file = config;
+  mapper_options.seed = static_cast<uint32_t>(seed);
+  hidden_rooms::RbpfMapper mapper(mapper_options);
+
+  rosbag::Bag bag;
+  try {
+    bag.open(bag_path, rosbag::bagmode::Read);
+  } catch (const rosbag::BagException& error) {
+    throw InputError(bag_path, std::string("cannot open the bag: ") + error.what());
+  }
+  const std::vector<std::string> topics{scan_topic, "/tf", "/tf_static", truth_topic};
+  rosbag::View view(bag, rosbag::TopicQuery(topics));
+  int scans_in_bag = 0;
+  for (const rosbag::ConnectionInfo* connection : view.getConnections())
+    if (connection->datatype == "sensor_msgs/LaserScan" &&
+        (connection->topic == scan_topic || connection->topic == "/" + scan_topic))
+      scans_in_bag = 1;
+  if (scans_in_bag == 0) throw InputError(bag_path, "no sensor_msgs/LaserScan on topic " + scan_topic);
+  const double bag_start = view.getBeginTime().toSec(), bag_end = view.getEndTime().toSec();
+  const double bag_seconds = std::max(bag_end - bag_start, 1e-9);
+
+  tf2::BufferCore tf_buffer(ros::Duration(std::max(60.0, bag_seconds + 10.0)));
+  std::deque<sensor_msgs::LaserScan::ConstPtr> pending;
+  std::vector<TimedPose> true_poses;
+  std::vector<double> scan_times;
+  std::vector<Pose2> estimate;
+  std::vector<std::pair<double, hidden_rooms::RangeScan>> inserted_scans;  // for the observed cells
+  int processed = 0, dropped = 0, received = 0;
+  std::string last_tf_error;
+  const Clock::time_point start = Clock::now();
+  Clock::time_point last_progress = start;
+
+  auto process = [&](const sensor_msgs::LaserScan& scan) {
+    try {
+      const Pose2 odometry =
+          hidden_rooms::fromRos(tf_buffer.lookupTransform(odom_frame, base_frame, scan.header.stamp).transform);
+      const Pose2 sensor =
+          hidden_rooms::fromRos(tf_buffer.lookupTransform(base_frame, scan.header.frame_id, ros::Time(0)).transform);
+      const hidden_rooms::RangeScan range_scan = hidden_rooms::fromRos(scan, sensor);
+      const bool inserted = mapper.addScan(odometry, range_scan);
+      ++processed;
+      if (!environment_path.empty()) {
+        scan_times.push_back(scan.header.stamp.toSec());
+        estimate.push_back(mapper.pose());
+        if (inserted) inserted_scans.emplace_back(scan.header.stamp.toSec(), range_scan);
+      }
+    } catch (const tf2::TransformException& error) {
+      ++dropped;
+      last_tf_error = error.what();
+    } catch (const InputError& error) {
+      ++dropped;
+      last_tf_error = error.what();
+    }
+  };
+
+  for (const rosbag::MessageInstance& message : view) {
+    if (const auto tf = message.instantiate<tf2_msgs::TFMessage>()) {
+      const bool is_static = message.getTopic() == "/tf_static";
+      for (const geometry_msgs::TransformStamped& transform : tf->transforms)
+        tf_buffer.setTransform(transform, "bag", is_static);
+    } else if (const auto scan = message.instantiate<sensor_msgs::LaserScan>()) {
+      pending.push_back(scan);
+      ++received;
+    } else if (const auto odometry = message.instantiate<nav_msgs::Odometry>()) {
+      true_poses.push_back({odometry->header.stamp.toSec(), hidden_rooms::fromRos(odometry->pose.pose)});
+    }
+    // A scan is processed once the odometry after its stamp is in the buffer (tf at the scan's time).
+    while (!pending.empty() && tf_buffer.canTransform(odom_frame, base_frame, pending.front()->header.stamp)) {
+      process(*pending.front());
+      pending.pop_front();
+    }
+    if (!quiet && seconds(Clock::now() - last_progress) > 0.5) {
+      last_progress = Clock::now();
+      const double done = message.getTime().toSec() - bag_start;
+      std::fprintf(stderr, "\rmap_from_bag: %5.1f%%  %.1f / %.1f s of bag, %d scans, %.1fx real time   ",
+                   100.0 * done / bag_seconds, done, bag_seconds, processed,
+                   done / std::max(seconds(last_progress - start), 1e-9));
+    }
+  }
+  for (; !pending.empty(); pending.pop_front()) process(*pending.front());  // the last ones, if tf allows
+  bag.close();
+  const double wall_seconds = seconds(Clock::now() - start);
+  if (!quiet) std::fprintf(stderr, "\n");
+  if (processed == 0)
+    throw InputError(bag_path, received == 0 ? "no scans on topic " + scan_topic
+                                             : "no scan has odometry (" + odom_frame + " -> " + base_frame +
+                                                   " in /tf) at its stamp: " + last_tf_error);
+
+  const hidden_rooms::OccupancyGrid map = mapper.map();
+  const std::string yaml = hidden_rooms::saveMap(map, prefix);
+  std::printf("bag: %s\nmap: %s\nscans: %d\nscans_inserted: %d\nscans_dropped: %d\nbag_seconds: %.2f\n"
+              "wall_seconds: %.2f\nspeed_factor: %.1f\n",
+              bag_path.c_str(), yaml.c_str(), processed, mapper.scansInserted(), dropped, bag_seconds, wall_seconds,
+              bag_seconds / std::max(wall_seconds, 1e-9));
+  if (environment_path.empty()) return hidden_rooms::kExitOk;
+
+  if (true_poses.empty()) throw InputError(bag_path, "no nav_msgs/Odometry on " + truth_topic + " to score against");
+  std::sort(true_poses.begin(), true_poses.end(), [](const TimedPose& a, const TimedPose& b) { return a.time < b.time; });
+  std::vector<Pose2> truth_at_scans;
+  for (double t : scan_times) truth_at_scans.push_back(interpolate(true_poses, t));
+  const Pose2 world_from_map = hidden_rooms::composePoses(truth_at_scans.back(), hidden_rooms::invertPose(estimate.back()));
+  cv::Mat1b observed;
+  for (const auto& [time, scan] : inserted_scans)
+    hidden_rooms::markObservedCells(truth.map, hidden_rooms::composePoses(interpolate(true_poses, time), scan.sensor_pose),
+                                    scan, &observed);
+  const hidden_rooms::MapQuality quality = hidden_rooms::evaluateMap(map, world_from_map, truth.map, observed);
+  const hidden_rooms::TrajectoryError trajectory = hidden_rooms::trajectoryError(estimate, truth_at_scans, world_from_map);
+  char text[1024];
+  std::snprintf(text, sizeof(text),
+                "free_iou: %.4f\ntrue_free_cells: %lld\nmap_free_cells: %lld\nwalls_within_2_cells: %.4f\n"
+                "wall_distance_mean_cells: %.3f\nwall_distance_p95_cells: %.3f\ntrajectory_poses: %d\n"
+                "trajectory_rmse_m: %.4f\ntrajectory_max_m: %.4f\nyaw_rmse_rad: %.4f\n",
+                quality.free_iou, quality.true_free_cells, quality.map_free_cells, quality.walls_within_2_cells,
+                quality.wall_distance_mean, quality.wall_distance_p95, trajectory.poses, trajectory.position_rmse,
+                trajectory.position_max, trajectory.yaw_rmse);
+  std::printf("%s", text);
+  if (!metrics_path.empty()) {
+    std::ofstream out(metrics_path);
+    out << "bag: " << bag_path << "\nbag_seconds: " << bag_seconds << "\nwall_seconds: " << wall_seconds
+        << "\nspeed_factor: " << bag_seconds / std::max(wall_seconds, 1e-9) << "\nscans: " << processed
+        << "\nscans_inserted: " << mapper.scansInserted() << "\n" << text;
+    if (!out) throw InputError(metrics_path, "cannot write");
+  }
+  return hidden_rooms::kExitOk;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return hidden_rooms::runTool("map_from_bag", [&] { return run(argc, argv); });
+}

@@ -1,0 +1,157 @@
+#include "hidden_rooms/ros/mapper.h"
+
+#include <cmath>
+
+#include <geometry_msgs/PoseArray.h>
+#include <nav_msgs/MapMetaData.h>
+#include <nav_msgs/OccupancyGrid.h>
+
+#include "hidden_rooms/input_error.h"
+#include "hidden_rooms/occupancy_grid.h"
+#include "hidden_rooms/ros/conversions.h"
+
+namespace hidden_rooms {
+
+MapperOptions readMapperOptions(const ros::NodeHandle& nh) {
+  MapperOptions options;
+  nh.param("config_file", options.rbpf.config_file, options.rbpf.config_file);
+  nh.param("config_section", options.rbpf.section, options.rbpf.section);
+  int seed = 0;
+  nh.param("seed", seed, seed);
+  if (seed < 0) throw InputError("~seed", "must be zero or positive");
+  options.rbpf.seed = static_cast<uint32_t>(seed);
+  nh.param("scan_topic", options.scan_topic, options.scan_topic);
+  nh.param("map_frame", options.map_frame, options.map_frame);
+  nh.param("odom_frame", options.odom_frame, options.odom_frame);
+  nh.param("base_frame", options.base_frame, options.base_frame);
+  nh.param("map_update_interval", options.map_update_interval, options.map_update_interval);
+  nh.param("tf_publish_rate", options.tf_publish_rate, options.tf_publish_rate);
+  nh.param("transform_tolerance", options.transform_tolerance, options.transform_tolerance);
+  nh.param("tf_wait", options.tf_wait, options.tf_wait);
+  nh.param("publish_particles", options.publish_particles, options.publish_particles);
+  if (options.rbpf.config_file.empty()) throw InputError("~config_file", "must name the MRPT ini (config/rbpf.ini)");
+  for (const auto& [name, value] : {std::pair<const char*, double>{"map_update_interval", options.map_update_interval},
+                                    {"tf_publish_rate", options.tf_publish_rate},
+                                    {"transform_tolerance", options.transform_tolerance},
+                                    {"tf_wait", options.tf_wait}})
+    if (!std::isfinite(value) || value < 0.0) throw InputError(std::string("~") + name, "must be zero or positive");
+  for (const std::string* frame : {&options.map_frame, &options.odom_frame, &options.base_frame})
+    if (frame->empty()) throw InputError("~map_frame, ~odom_frame, ~base_frame", "must not be empty");
+  return options;
+}
+
+Mapper::Mapper(ros::NodeHandle nh, const MapperOptions& options)
+    : options_(options),
+      mapper_(std::make_unique<RbpfMapper>(options.rbpf)),
+      tf_buffer_(ros::Duration(30.0)),
+      tf_listener_(tf_buffer_) {
+  scan_subscriber_ = nh.subscribe(options.scan_topic, 50, &Mapper::onScan, this);
+  map_publisher_ = nh.advertise<nav_msgs::OccupancyGrid>("map", 1, true);
+  metadata_publisher_ = nh.advertise<nav_msgs::MapMetaData>("map_metadata", 1, true);
+  if (options.publish_particles) particles_publisher_ = nh.advertise<geometry_msgs::PoseArray>("particles", 1);
+  save_service_ = nh.advertiseService("save_map", &Mapper::onSaveMap, this);
+  if (options.tf_publish_rate > 0.0)
+    tf_timer_ = nh.createTimer(ros::Duration(1.0 / options.tf_publish_rate), &Mapper::onTimer, this);
+}
+
+void Mapper::onScan(const sensor_msgs::LaserScan::ConstPtr& scan) {
+  if (!last_scan_stamp_.isZero() && scan->header.stamp < last_scan_stamp_) {
+    // Time went back (a bag restarted, the simulator was reset with a new clock): the filter cannot go back.
+    ROS_WARN_THROTTLE(5.0, "mapper: scan stamped %.3f before the last one (%.3f); ignored",
+                      scan->header.stamp.toSec(), last_scan_stamp_.toSec());
+    return;
+  }
+  last_scan_stamp_ = scan->header.stamp;
+  pending_.push_back(scan);
+  processPending();
+}
+
+// Scans wait (in order) until the odometry at their stamp is in the tf buffer; those that waited longer than
+// ~tf_wait (in scan time) are dropped.
+void Mapper::processPending() {
+  while (!pending_.empty()) {
+    const sensor_msgs::LaserScan& scan = *pending_.front();
+    if (tf_buffer_.canTransform(options_.odom_frame, options_.base_frame, scan.header.stamp)) {
+      if (process(scan)) ++processed_;
+      pending_.pop_front();
+    } else if ((last_scan_stamp_ - scan.header.stamp).toSec() > options_.tf_wait) {
+      ++dropped_;
+      ROS_WARN_THROTTLE(5.0, "mapper: no %s -> %s at scan stamp %.3f; scan dropped (%d so far)",
+                        options_.odom_frame.c_str(), options_.base_frame.c_str(), scan.header.stamp.toSec(), dropped_);
+      pending_.pop_front();
+    } else {
+      break;
+    }
+  }
+}
+
+bool Mapper::process(const sensor_msgs::LaserScan& scan) {
+  Pose2 odometry, sensor;
+  try {
+    odometry = fromRos(tf_buffer_.lookupTransform(options_.odom_frame, options_.base_frame, scan.header.stamp).transform);
+    sensor = fromRos(tf_buffer_.lookupTransform(options_.base_frame, scan.header.frame_id, ros::Time(0)).transform);
+  } catch (const tf2::TransformException& error) {
+    ROS_WARN_THROTTLE(5.0, "mapper: %s; scan dropped", error.what());
+    ++dropped_;
+    return false;
+  }
+  try {
+    mapper_->addScan(odometry, fromRos(scan, sensor));
+  } catch (const InputError& error) {
+    ROS_WARN_THROTTLE(5.0, "mapper: bad scan: %s", error.what());
+    ++dropped_;
+    return false;
+  }
+  // With a tf rate the timer publishes map -> odom (one stamp per ROS time, no repeated data), else each scan.
+  if (options_.tf_publish_rate <= 0.0) publishTransform(scan.header.stamp);
+  if (options_.publish_particles)
+    particles_publisher_.publish(toRos(mapper_->particles(), options_.map_frame, scan.header.stamp));
+  if (!map_published_ || (scan.header.stamp - last_map_stamp_).toSec() >= options_.map_update_interval)
+    publishMap(scan.header.stamp);
+  return true;
+}
+
+void Mapper::publishMap(const ros::Time& stamp) {
+  const OccupancyGrid grid = mapper_->map();
+  if (grid.empty()) return;
+  const nav_msgs::OccupancyGrid message = toRos(grid, options_.map_frame, stamp);
+  map_publisher_.publish(message);
+  metadata_publisher_.publish(message.info);
+  last_map_stamp_ = stamp;
+  map_published_ = true;
+}
+
+void Mapper::publishTransform(const ros::Time& stamp) {
+  if (stamp <= last_tf_stamp_) return;  // time has not moved (simulated clock slower than the timer)
+  last_tf_stamp_ = stamp;
+  tf_broadcaster_.sendTransform(toTransform(mapper_->mapToOdom(), options_.map_frame, options_.odom_frame,
+                                            stamp + ros::Duration(options_.transform_tolerance)));
+}
+
+void Mapper::onTimer(const ros::TimerEvent&) {
+  if (processed_ > 0) publishTransform(ros::Time::now());
+}
+
+bool Mapper::onSaveMap(hidden_rooms::SaveMap::Request& request, hidden_rooms::SaveMap::Response& response) {
+  const OccupancyGrid grid = mapper_->map();
+  if (grid.empty()) {
+    response.success = false;
+    response.message = "no map yet: no scan has been processed";
+    return true;
+  }
+  if (request.prefix.empty()) {
+    response.success = false;
+    response.message = "empty prefix";
+    return true;
+  }
+  try {
+    response.message = saveMap(grid, request.prefix);
+    response.success = true;
+  } catch (const InputError& error) {
+    response.success = false;
+    response.message = error.what();
+  }
+  return true;
+}
+
+}  // namespace hidden_rooms
