@@ -43,13 +43,25 @@ PredictionResult predictEveryDoor(const PredictionRequest& request, double start
   return result;
 }
 
-// Unknown cells connected (4-neighbours) to `start` through unknown cells, restricted to `allowed`.
-cv::Mat1b connectedUnknown(const OccupancyGrid& map, const cv::Mat1b& allowed, cv::Point start) {
-  cv::Mat1b passable = (map.cells == OccupancyGrid::kUnknown) & allowed;
-  cv::Mat1b mask = cv::Mat1b::zeros(map.height() + 2, map.width() + 2);
-  if (passable(start) == 0) return cv::Mat1b::zeros(map.cells.size());
-  cv::floodFill(passable, mask, start, 255, nullptr, 0, 0, 4 | cv::FLOODFILL_MASK_ONLY | (255 << 8));
-  return mask(cv::Rect(1, 1, map.width(), map.height())).clone();
+// std::floor as an int without the library call (the hot loop of the ray casting).
+inline int floorToInt(double value) {
+  const int truncated = static_cast<int>(value);
+  return value < truncated ? truncated - 1 : truncated;
+}
+
+// Unknown cells connected (4-neighbours) to `start` through unknown cells where `allowed` (given over `window`
+// of the map; nothing outside it is allowed) is set. Full-size mask.
+cv::Mat1b connectedUnknown(const OccupancyGrid& map, const cv::Mat1b& allowed, const cv::Rect& window,
+                           cv::Point start) {
+  cv::Mat1b result = cv::Mat1b::zeros(map.cells.size());
+  if (!window.contains(start)) return result;
+  const cv::Mat1b passable = (map.cells(window) == OccupancyGrid::kUnknown) & allowed;
+  const cv::Point seed = start - window.tl();
+  if (passable(seed) == 0) return result;
+  cv::Mat1b mask = cv::Mat1b::zeros(window.height + 2, window.width + 2);
+  cv::floodFill(passable, mask, seed, 255, nullptr, 0, 0, 4 | cv::FLOODFILL_MASK_ONLY | (255 << 8));
+  mask(cv::Rect(1, 1, window.width, window.height)).copyTo(result(window));
+  return result;
 }
 
 }  // namespace
@@ -72,7 +84,7 @@ PredictionResult UnstructuredPredictor::predict(const PredictionRequest& request
       const double angle = 2.0 * CV_PI * i / rays;
       const cv::Point2d step(0.5 * std::cos(angle), 0.5 * std::sin(angle));
       for (cv::Point2d p = origin;; p += step) {
-        const cv::Point cell(static_cast<int>(std::floor(p.x)), static_cast<int>(std::floor(p.y)));
+        const cv::Point cell(floorToInt(p.x), floorToInt(p.y));
         if (!box.contains(cell) || request.map.cells(cell) != OccupancyGrid::kUnknown) break;
         room->mask(cell) = 255;
       }
@@ -102,28 +114,32 @@ PredictionResult SkewNormalPredictor::predict(const PredictionRequest& request) 
     // Normal of the door line, pointing to the side of the start cell (the unknown side).
     Point2 normal = door.orientation == DoorOrientation::kAlongX ? Point2(0, 1) : Point2(1, 0);
     if ((map.cellCentre(start.x, start.y) - door.position).dot(normal) < 0) normal = -normal;
-    const Point2 along(normal.y(), -normal.x());
     const double alpha = shape_per_width * door.width;
-    // Density 2 phi(u) Phi(alpha u_n / sigma) in the door frame; evaluated within 4 sigma.
-    auto density = [&](const Point2& p) {
-      const Point2 u = p - door.position;
-      const double n = u.dot(normal) / sigma, a = u.dot(along) / sigma;
-      return 2.0 * std::exp(-0.5 * (n * n + a * a)) * 0.5 * std::erfc(-alpha * n / std::sqrt(2.0));
-    };
+    // Density 2 phi(u) Phi(alpha u_n / sigma) in the door frame, evaluated within 4 sigma. The door's axes are
+    // the map's, so it separates into a factor per column and one per row.
     const int half = static_cast<int>(std::ceil(4.0 * sigma / map.resolution));
     int col = 0, row = 0;
     map.cellOf(door.position, &col, &row);
     const cv::Rect window = cv::Rect(col - half, row - half, 2 * half + 1, 2 * half + 1) &
                             cv::Rect(0, 0, map.width(), map.height());
-    cv::Mat1f values = cv::Mat1f::zeros(map.cells.size());
+    if (window.area() == 0) return;  // the door lies farther than 4 sigma outside the map: nothing likely
+    auto factor = [&](double offset, double normal_component) {  // offset: metres from the door along an axis
+      const double t = offset / sigma;
+      return normal_component != 0.0
+                 ? std::exp(-0.5 * t * t) * std::erfc(-alpha * normal_component * t / std::sqrt(2.0))
+                 : std::exp(-0.5 * t * t);
+    };
+    cv::Mat1f column_factor(1, window.width), row_factor(window.height, 1);
+    for (int c = 0; c < window.width; ++c)
+      column_factor(0, c) = static_cast<float>(
+          factor(map.cellCentre(window.x + c, 0).x() - door.position.x(), normal.x()));
+    for (int r = 0; r < window.height; ++r)
+      row_factor(r, 0) = static_cast<float>(
+          factor(map.cellCentre(0, window.y + r).y() - door.position.y(), normal.y()));
+    const cv::Mat1f values = row_factor * column_factor;  // proportional to the density over the window
     double peak = 0.0;
-    for (int r = window.y; r < window.br().y; ++r)
-      for (int c = window.x; c < window.br().x; ++c) {
-        values(r, c) = static_cast<float>(density(map.cellCentre(c, r)));
-        peak = std::max(peak, static_cast<double>(values(r, c)));
-      }
-    const cv::Mat1b likely_free = values > threshold * peak;
-    room->mask = connectedUnknown(map, likely_free, start);
+    cv::minMaxLoc(values, nullptr, &peak);
+    room->mask = connectedUnknown(map, values > threshold * peak, window, start);
     room->terms["alpha"] = alpha;
   });
 }

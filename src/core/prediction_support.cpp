@@ -46,7 +46,11 @@ bool nearestUnknownCell(const OccupancyGrid& map, const Point2& position, double
 }
 
 void finishPrediction(const OccupancyGrid& map, RoomPrediction* room) {
-  const int cells = room->mask.empty() ? 0 : cv::countNonZero(room->mask);
+  // The room's bounding box and one more pixel around it (where it is inside the image): all the work below.
+  const cv::Rect box = room->mask.empty() ? cv::Rect() : cv::boundingRect(room->mask);
+  const cv::Rect roi = cv::Rect(box.x - 1, box.y - 1, box.width + 2, box.height + 2) &
+                       cv::Rect(0, 0, room->mask.cols, room->mask.rows);
+  const int cells = box.area() == 0 ? 0 : cv::countNonZero(room->mask(roi));
   if (cells == 0) {
     room->placed = false;
     if (room->problem.empty()) room->problem = "no room predicted";
@@ -58,7 +62,7 @@ void finishPrediction(const OccupancyGrid& map, RoomPrediction* room) {
   room->problem.clear();
   room->area = cells * map.resolution * map.resolution;
   std::vector<std::vector<cv::Point>> contours;
-  cv::findContours(room->mask.clone(), contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_SIMPLE);
+  cv::findContours(room->mask(roi).clone(), contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_SIMPLE, roi.tl());
   const auto largest = std::max_element(contours.begin(), contours.end(), [](const auto& a, const auto& b) {
     return cv::contourArea(a) < cv::contourArea(b);
   });
