@@ -32,10 +32,12 @@ import numpy as np
 import yaml
 from tqdm import tqdm
 
+# The package's Python module, from this checkout (also when the workspace is not sourced).
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.realpath(__file__))), "src"))
+from hidden_rooms import batch_analysis  # noqa: E402
+
 BINARY_NAME = "predict_rooms_offline"
 GNU_TIME = "/usr/bin/time"
-PACKAGE_NAME = "hidden_rooms"
-REPO_DIR = os.path.dirname(os.path.dirname(os.path.realpath(__file__)))
 STDERR_EXCERPT_LINES = 8
 MAX_DOORS_ROW = 15
 MAX_FAILURES_LISTED = 20
@@ -162,20 +164,10 @@ def score_reference(case):
 
 def find_binary(explicit=None):
     """Path of predict_rooms_offline: --binary, else $CMAKE_PREFIX_PATH's lib/hidden_rooms, else the repo's .ws."""
-    if explicit:
-        if not (os.path.isfile(explicit) and os.access(explicit, os.X_OK)):
-            raise BenchmarkError("--binary %s is not an executable file" % explicit)
-        return explicit
-    candidates = []
-    for prefix in os.environ.get("CMAKE_PREFIX_PATH", "").split(os.pathsep):
-        if prefix:
-            candidates.append(os.path.join(prefix, "lib", PACKAGE_NAME, BINARY_NAME))
-    candidates.append(os.path.join(REPO_DIR, ".ws", "devel", "lib", PACKAGE_NAME, BINARY_NAME))
-    for candidate in candidates:
-        if os.path.isfile(candidate) and os.access(candidate, os.X_OK):
-            return candidate
-    raise BenchmarkError("%s not found; looked in:\n  %s\nBuild the workspace and `source .ws/devel/setup.bash`, "
-                         "or pass --binary PATH" % (BINARY_NAME, "\n  ".join(candidates)))
+    try:
+        return batch_analysis.find_binary(BINARY_NAME, explicit)
+    except batch_analysis.BatchError as error:
+        raise BenchmarkError(str(error))
 
 
 def known_methods(binary):
