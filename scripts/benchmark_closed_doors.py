@@ -34,7 +34,7 @@ from tqdm import tqdm
 
 # The package's Python module, from this checkout (also when the workspace is not sourced).
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.realpath(__file__))), "src"))
-from hidden_rooms import batch_analysis  # noqa: E402
+from hidden_rooms import package_tools  # noqa: E402
 
 BINARY_NAME = "predict_rooms_offline"
 GNU_TIME = "/usr/bin/time"
@@ -165,8 +165,8 @@ def score_reference(case):
 def find_binary(explicit=None):
     """Path of predict_rooms_offline: --binary, else $CMAKE_PREFIX_PATH's lib/hidden_rooms, else the repo's .ws."""
     try:
-        return batch_analysis.find_binary(BINARY_NAME, explicit)
-    except batch_analysis.BatchError as error:
+        return package_tools.find_binary(BINARY_NAME, explicit)
+    except package_tools.ToolError as error:
         raise BenchmarkError(str(error))
 
 

@@ -30,6 +30,8 @@ PACKAGES=(
   python3-opencv xvfb time
   # batch analysis: the Python module's install (setuptools) and the Dask cluster option
   python3-setuptools python3-distributed
+  # fuzzing (scripts/fuzz.sh): clang with libFuzzer
+  clang libclang-rt-14-dev
 )
 
 missing=()

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Runs every test of hidden_rooms: sets up and builds (scripts/setup.sh), runs the gtest unit tests, rostests,
 # Python tests and launch-file checks through `catkin_make run_tests`, then builds the core's unit tests with
-# AddressSanitizer + UndefinedBehaviorSanitizer and runs them. Exits non-zero when any test fails.
+# AddressSanitizer + UndefinedBehaviorSanitizer and runs them, and runs every fuzz target for 20 s
+# (HIDDEN_ROOMS_FUZZ_SECONDS). Exits non-zero when any test fails.
 set -euo pipefail
 
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -34,6 +35,11 @@ ASAN_OPTIONS=detect_leaks=1:abort_on_error=0 UBSAN_OPTIONS=print_stacktrace=1:ha
   "$WS/devel_sanitize/lib/hidden_rooms/test_core" \
   --gtest_output=xml:"$WS/build/test_results/hidden_rooms/gtest-test_core_sanitized.xml" || sanitized_status=$?
 
+# Every fuzz target briefly (scripts/fuzz.sh runs them as long as asked).
+fuzz_status=0
+bash "$ROOT/scripts/fuzz.sh" "${HIDDEN_ROOMS_FUZZ_SECONDS:-20}" || fuzz_status=$?
+cd "$WS"
+
 results_status=0
 catkin_test_results build/test_results || results_status=$?
 # One closing line, "tests: N passed, N failed, N skipped", counted per test case from the result files
@@ -56,4 +62,5 @@ for path in glob.glob(os.path.join(sys.argv[1], "**", "*.xml"), recursive=True):
             passed += 1
 print("tests: %d passed, %d failed, %d skipped" % (passed, failed, skipped))
 PY
-[ "$results_status" -eq 0 ] && [ "$sanitized_status" -eq 0 ]
+[ "$fuzz_status" -eq 0 ] || echo "fuzzing: FAILED (see .fuzz/)"
+[ "$results_status" -eq 0 ] && [ "$sanitized_status" -eq 0 ] && [ "$fuzz_status" -eq 0 ]

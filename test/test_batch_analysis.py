@@ -34,8 +34,8 @@ def required():
 
 def tool_or_skip():
     try:
-        return batch_analysis.find_binary()
-    except batch_analysis.BatchError as error:
+        return batch_analysis.find_binary(batch_analysis.TOOL_NAME)
+    except batch_analysis.ToolError as error:
         if required():
             raise AssertionError("batch_cases not built: %s" % error)
         raise unittest.SkipTest("batch_cases not built: %s" % error)

@@ -5,6 +5,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "hidden_rooms/file_io.h"
 #include "hidden_rooms/image_io.h"
 #include "hidden_rooms/input_error.h"
 #include "test_util.h"
@@ -113,6 +114,32 @@ TEST(ImageIo, ReadsTheBenchmarkImagesLikeOpenCv) {
       const std::string path = root + "/" + case_dir + "/" + name;
       EXPECT_TRUE(sameImage(readImage(path), cv::imread(path, cv::IMREAD_UNCHANGED))) << path;
     }
+}
+
+}  // namespace
+}  // namespace hidden_rooms
+
+namespace hidden_rooms {
+namespace {
+
+TEST(FileIo, WritesAtomicallyAndLeavesNoPartialFile) {
+  const std::string dir = testing::makeTempDir("write_atomically");
+  const std::string path = dir + "/out.txt";
+  writeTextAtomically(path, "first\n", "test file");
+  EXPECT_EQ(readTextFile(path, "test file"), "first\n");
+  // A writer that fails half-way leaves the old file as it was and nothing else in the folder.
+  EXPECT_THROW(writeAtomically(path,
+                               [](const std::string& temporary) {
+                                 std::ofstream(temporary) << "half";
+                                 throw InputError("test", "failed half-way");
+                               }),
+               InputError);
+  EXPECT_EQ(readTextFile(path, "test file"), "first\n");
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir), std::filesystem::directory_iterator()), 1);
+  // An image write that fails (unsupported pixel type) leaves nothing either.
+  EXPECT_THROW(writeImage(dir + "/bad.png", cv::Mat(2, 2, CV_32FC1, cv::Scalar(0))), InputError);
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir), std::filesystem::directory_iterator()), 1);
+  EXPECT_THROW(writeTextAtomically(dir + "/no/such/folder/x.txt", "x", "test file"), InputError);
 }
 
 }  // namespace

@@ -150,7 +150,7 @@ TEST(Prediction, InsertionFillsTheRoomAndOpensItsDoor) {
   // The door is open: from the corridor the flood reaches the inserted room.
   int col = 0, row = 0;
   ASSERT_TRUE(completed.cellOf(Point2(5.0, 5.0), &col, &row));
-  const cv::Mat1b reached = testing::reachableFreeCells(completed, col, row);
+  const cv::Mat1b reached = reachableFreeCells(completed, col, row);
   EXPECT_GT(cv::countNonZero(reached & result.rooms[0].mask), 0.9 * cv::countNonZero(result.rooms[0].mask));
   // Nothing known in the input is lost except the door's own cells.
   EXPECT_LT(cv::countNonZero((request.map.cells == OccupancyGrid::kOccupied) & (completed.cells == OccupancyGrid::kFree)),

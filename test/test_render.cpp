@@ -11,7 +11,6 @@
 namespace hidden_rooms {
 namespace {
 
-using testing::reachableFreeCells;
 
 // The free cell of a space farthest from its boundary.
 cv::Point interiorCell(const RenderedEnvironment& rendered, int space_index) {

@@ -10,11 +10,14 @@
 
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <set>
 #include <sstream>
 
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
+#include "hidden_rooms/octomap_io.h"
 #include "hidden_rooms/prediction_support.h"
 #include "hidden_rooms/ros/conversions.h"
 #include "test_util.h"
@@ -179,6 +182,24 @@ TEST(RoomPredictor, PublishesLatchedOverlays) {
   EXPECT_EQ(per_namespace["debug_in_out_cells"], 1);
 }
 
+TEST(RoomPredictor, WritesTheCompletedMapAsAnOctomap) {
+  REQUIRE_CASE();
+  ros::NodeHandle nh;
+  const auto completed =
+      ros::topic::waitForMessage<nav_msgs::OccupancyGrid>("octomap/predicted_map", nh, ros::Duration(60.0));
+  ASSERT_TRUE(completed != nullptr);
+  const std::string path = "/tmp/hidden_rooms_test_room_predictor_octomap/predicted.ot";
+  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(60.0);
+  while (!std::filesystem::exists(path) && ros::WallTime::now() < deadline) ros::WallDuration(0.1).sleep();
+  ASSERT_TRUE(std::filesystem::exists(path)) << "no 3D map written";
+  // Its band between floor and ceiling is the completed map, cut to its known cells.
+  const hidden_rooms::OccupancyGrid map = hidden_rooms::fromRos(*completed);
+  const hidden_rooms::OccupancyGrid sliced = hidden_rooms::sliceOctomap(path, hidden_rooms::SliceOptions());
+  const cv::Rect known = cv::boundingRect(map.cells != hidden_rooms::OccupancyGrid::kUnknown);
+  ASSERT_EQ(sliced.cells.size(), known.size());
+  EXPECT_EQ(cv::countNonZero(sliced.cells != map.cells(known)), 0);
+}
+
 void expectFailure(PredictRooms* service, const std::vector<std::string>& words, const std::string& name = "predict_rooms") {
   ASSERT_TRUE(call(service, name)) << "the service call itself failed (node down?)";
   EXPECT_FALSE(service->response.success);
@@ -207,6 +228,33 @@ TEST(RoomPredictor, BadRequestsFailWithAMessageAndTheNodeKeepsServing) {
     empty.cells = cv::Mat_<int8_t>(400, 400, hidden_rooms::OccupancyGrid::kUnknown);
     service.request.map = hidden_rooms::toRos(empty, "map", ros::Time::now());
     expectFailure(&service, {"map", "no known cell"});
+  }
+  {
+    SCOPED_TRACE("map with no free cell");
+    PredictRooms service;
+    service.request.doors = hidden_rooms::toRos(doors);
+    hidden_rooms::OccupancyGrid walls = hidden_rooms::loadMap(caseDir() + "/map.yaml");
+    walls.cells.setTo(hidden_rooms::OccupancyGrid::kOccupied);
+    service.request.map = hidden_rooms::toRos(walls, "map", ros::Time::now());
+    expectFailure(&service, {"map", "no free cell"});
+  }
+  {
+    SCOPED_TRACE("a map too large, thousands of doors, a NaN position");
+    PredictRooms huge;
+    huge.request.map.info.width = 100000;
+    huge.request.map.info.height = 100000;
+    huge.request.map.info.resolution = 0.05f;
+    const ros::WallTime start = ros::WallTime::now();
+    expectFailure(&huge, {"map", "max_map_cells"});
+    PredictRooms many;
+    many.request.doors.resize(5000, hidden_rooms::toRos(doors).front());
+    for (size_t k = 0; k < many.request.doors.size(); ++k) many.request.doors[k].id = static_cast<int>(k);
+    expectFailure(&many, {"5000 doors", "max_doors"});
+    EXPECT_LT((ros::WallTime::now() - start).toSec(), 5.0);
+    PredictRooms nan_door;
+    nan_door.request.doors = hidden_rooms::toRos(doors);
+    nan_door.request.doors[0].position.y = std::numeric_limits<double>::quiet_NaN();
+    expectFailure(&nan_door, {"door " + std::to_string(doors.doors[0].id), "finite"});
   }
   {
     SCOPED_TRACE("map whose data does not match its size");

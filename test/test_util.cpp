@@ -19,14 +19,6 @@
 
 namespace hidden_rooms::testing {
 
-cv::Mat1b reachableFreeCells(const OccupancyGrid& grid, int col, int row) {
-  cv::Mat1b passable = (grid.cells == OccupancyGrid::kFree);
-  cv::Mat1b mask = cv::Mat1b::zeros(grid.height() + 2, grid.width() + 2);
-  if (passable(row, col) == 0) return cv::Mat1b::zeros(grid.height(), grid.width());
-  cv::floodFill(passable, mask, cv::Point(col, row), 128, nullptr, 0, 0,
-                4 | cv::FLOODFILL_MASK_ONLY | (255 << 8));
-  return mask(cv::Rect(1, 1, grid.width(), grid.height())).clone();
-}
 
 }  // namespace hidden_rooms::testing
 

@@ -55,9 +55,6 @@ inline std::string makeTempDir(const std::string& name) {
   return dir.string();
 }
 
-// Cells reachable from (col, row) through free cells (4-connected), as a 0/255 mask.
-cv::Mat1b reachableFreeCells(const OccupancyGrid& grid, int col, int row);
-
 }  // namespace hidden_rooms::testing
 
 namespace hidden_rooms::testing {

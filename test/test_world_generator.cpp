@@ -67,7 +67,7 @@ TEST(WorldGenerator, EverySpaceIsReachableWithAllDoorsOpen) {
           if (rendered.space_labels(row, col) == corridor + 1) start = {col, row};
       ASSERT_GE(start.x, 0) << "the corridor has no free cell";
 
-      const cv::Mat1b reachable = testing::reachableFreeCells(rendered.map, start.x, start.y);
+      const cv::Mat1b reachable = reachableFreeCells(rendered.map, start.x, start.y);
       std::set<int> present, reached;
       for (int row = 0; row < reachable.rows; ++row)
         for (int col = 0; col < reachable.cols; ++col) {

@@ -62,4 +62,8 @@ OccupancyGrid gridFromImage(const cv::Mat& image, const MapMetadata& metadata);
 // cells <= 19 are free, >= 65 occupied). Returns the yaml path. Throws InputError when it cannot write.
 std::string saveMap(const OccupancyGrid& grid, const std::string& prefix);
 
+// Free cells reachable from (col, row) through free cells (4-connected), as a 0/255 mask of the grid's size; all
+// zero when (col, row) is outside the grid or not free.
+cv::Mat1b reachableFreeCells(const OccupancyGrid& grid, int col, int row);
+
 }  // namespace hidden_rooms

@@ -29,7 +29,7 @@ void finishPrediction(const OccupancyGrid& map, RoomPrediction* room);
 // The prediction of a door that could not be placed: empty mask of the map's size, placed = false, `problem`.
 RoomPrediction unplacedRoom(const OccupancyGrid& map, int door_id, const std::string& problem);
 
-// Throws InputError when the map has no cells or no known cell.
+// Throws InputError when the map has no cells, no known cell or no free cell.
 void checkUsableMap(const OccupancyGrid& map);
 
 // For requests from outside (the predict_rooms service): throws InputError("door ID", ...) naming the first

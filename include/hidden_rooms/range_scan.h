@@ -23,5 +23,9 @@ struct RangeScan {
 // Pose composition and inverse in the plane (a then b: b expressed in a's frame).
 Pose2 composePoses(const Pose2& a, const Pose2& b);
 Pose2 invertPose(const Pose2& pose);
+// A point given in `pose`'s frame, in the frame `pose` is expressed in.
+Point2 transformPoint(const Pose2& pose, const Point2& point);
+// Angle wrapped into [-pi, pi].
+double wrapAngle(double angle);
 
 }  // namespace hidden_rooms

@@ -3,7 +3,6 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
-#include <fstream>
 #include <set>
 
 #include "hidden_rooms/file_io.h"
@@ -95,10 +94,7 @@ void saveDoors(const DoorsFile& doors, const std::string& path) {
     out << YAML::EndMap;
   }
   out << YAML::EndSeq << YAML::EndMap;
-  std::ofstream stream(path);
-  if (!stream) throw InputError(path, "cannot write doors file");
-  stream << out.c_str() << "\n";
-  if (!stream) throw InputError(path, "write failed");
+  writeTextAtomically(path, std::string(out.c_str()) + "\n", "doors file");
 }
 
 }  // namespace hidden_rooms

@@ -12,6 +12,7 @@
 #include <iterator>
 #include <vector>
 
+#include "hidden_rooms/file_io.h"
 #include "hidden_rooms/input_error.h"
 
 namespace hidden_rooms {
@@ -174,7 +175,10 @@ cv::Mat readImage(const std::string& path) {
   throw InputError(path, "not a PNG, PGM or PPM image");
 }
 
-void writeImage(const std::string& path, const cv::Mat& image) {
+namespace {
+
+// writeImage's work: errors name `path`, the bytes go to `file_path`.
+void writeImageFile(const std::string& path, const std::string& file_path, const cv::Mat& image) {
   if (image.empty()) throw InputError(path, "cannot write an empty image");
   std::string extension = std::filesystem::path(path).extension().string();
   std::transform(extension.begin(), extension.end(), extension.begin(),
@@ -184,7 +188,7 @@ void writeImage(const std::string& path, const cv::Mat& image) {
     if (pixels.type() != CV_8UC1 && pixels.type() != CV_16UC1)
       throw InputError(path, "a PGM holds 8- or 16-bit grey images only");
     const bool sixteen = pixels.depth() == CV_16U;
-    std::ofstream file(path, std::ios::binary);
+    std::ofstream file(file_path, std::ios::binary);
     file << "P5\n" << pixels.cols << " " << pixels.rows << "\n" << (sixteen ? 65535 : 255) << "\n";
     if (sixteen) {
       std::vector<unsigned char> bytes(pixels.total() * 2);
@@ -194,6 +198,7 @@ void writeImage(const std::string& path, const cv::Mat& image) {
     } else {
       file.write(reinterpret_cast<const char*>(pixels.data), static_cast<std::streamsize>(pixels.total()));
     }
+    file.close();
     if (!file) throw InputError(path, "cannot write image file");
     return;
   }
@@ -210,12 +215,18 @@ void writeImage(const std::string& path, const cv::Mat& image) {
   for (int r = 0; r < pixels.rows; ++r) rows[static_cast<size_t>(r)] = const_cast<png_bytep>(pixels.ptr<png_byte>(r));
   PngRows png_rows{static_cast<png_uint_32>(pixels.cols), static_cast<png_uint_32>(pixels.rows),
                    pixels.depth() == CV_16U ? 16 : 8, colour_type, rows.data()};
-  std::FILE* file = std::fopen(path.c_str(), "wb");
+  std::FILE* file = std::fopen(file_path.c_str(), "wb");
   if (file == nullptr) throw InputError(path, "cannot open image file for writing");
   char error[256] = "";
   const bool written = writePngRows(file, png_rows, error);
   const bool closed = std::fclose(file) == 0;
   if (!written || !closed) throw InputError(path, std::string("cannot write PNG: ") + (written ? "close failed" : error));
+}
+
+}  // namespace
+
+void writeImage(const std::string& path, const cv::Mat& image) {
+  writeAtomically(path, [&](const std::string& temporary) { writeImageFile(path, temporary, image); });
 }
 
 }  // namespace hidden_rooms

@@ -15,11 +15,6 @@ constexpr int8_t kOccupiedMin = 65;  // map_saver's occupied threshold
 bool isFree(int8_t value) { return value >= 0 && value <= kFreeMax; }
 bool isOccupied(int8_t value) { return value >= kOccupiedMin; }
 
-Point2 transformPoint(const Pose2& pose, const Point2& point) {
-  const double c = std::cos(pose.yaw), s = std::sin(pose.yaw);
-  return {pose.x + c * point.x() - s * point.y(), pose.y + s * point.x() + c * point.y()};
-}
-
 }  // namespace
 
 void markObservedCells(const OccupancyGrid& truth, const Pose2& laser_pose, const RangeScan& scan, cv::Mat1b* observed) {

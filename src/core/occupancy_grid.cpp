@@ -4,7 +4,6 @@
 
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 
 #include <opencv2/imgproc.hpp>
 
@@ -184,8 +183,6 @@ std::string saveMap(const OccupancyGrid& grid, const std::string& prefix) {
   const std::filesystem::path pgm_path = prefix + ".pgm";
   writeImage(pgm_path.string(), image);
 
-  std::ofstream yaml(yaml_path);
-  if (!yaml) throw InputError(yaml_path.string(), "cannot write map yaml");
   YAML::Emitter out;
   out << YAML::BeginMap;
   out << YAML::Key << "image" << YAML::Value << pgm_path.filename().string();
@@ -196,9 +193,17 @@ std::string saveMap(const OccupancyGrid& grid, const std::string& prefix) {
   out << YAML::Key << "occupied_thresh" << YAML::Value << 0.65;
   out << YAML::Key << "free_thresh" << YAML::Value << 0.196;
   out << YAML::EndMap;
-  yaml << out.c_str() << "\n";
-  if (!yaml) throw InputError(yaml_path.string(), "write failed");
+  writeTextAtomically(yaml_path.string(), std::string(out.c_str()) + "\n", "map yaml");
   return yaml_path.string();
+}
+
+cv::Mat1b reachableFreeCells(const OccupancyGrid& grid, int col, int row) {
+  cv::Mat1b mask = cv::Mat1b::zeros(grid.height() + 2, grid.width() + 2);
+  if (col < 0 || row < 0 || col >= grid.width() || row >= grid.height() || grid.cells(row, col) != OccupancyGrid::kFree)
+    return cv::Mat1b::zeros(grid.height(), grid.width());
+  cv::Mat1b passable = (grid.cells == OccupancyGrid::kFree);
+  cv::floodFill(passable, mask, cv::Point(col, row), 128, nullptr, 0, 0, 4 | cv::FLOODFILL_MASK_ONLY | (255 << 8));
+  return mask(cv::Rect(1, 1, grid.width(), grid.height())).clone();
 }
 
 }  // namespace hidden_rooms

@@ -3,11 +3,11 @@
 #include <yaml-cpp/yaml.h>
 
 #include <filesystem>
-#include <fstream>
 #include <iomanip>
 #include <ostream>
 
 #include "hidden_rooms/command_line.h"
+#include "hidden_rooms/file_io.h"
 #include "hidden_rooms/image_io.h"
 #include "hidden_rooms/input_error.h"
 #include "hidden_rooms/prediction_support.h"
@@ -17,9 +17,7 @@ namespace hidden_rooms {
 namespace {
 
 void writeYaml(const YAML::Emitter& out, const std::string& path) {
-  std::ofstream file(path);
-  file << out.c_str() << "\n";
-  if (!file) throw InputError(path, "cannot write");
+  writeTextAtomically(path, std::string(out.c_str()) + "\n", "YAML file");
 }
 
 void writeRoomsYaml(const PredictionRequest& request, const PredictionResult& result, const std::string& method,

@@ -83,6 +83,8 @@ void checkUsableMap(const OccupancyGrid& map) {
   if (map.empty()) throw InputError("map", "the map is empty");
   if (cv::countNonZero(map.cells != OccupancyGrid::kUnknown) == 0)
     throw InputError("map", "the map has no known cell");
+  if (cv::countNonZero(map.cells == OccupancyGrid::kFree) == 0)
+    throw InputError("map", "the map has no free cell (nothing was explored)");
   if (!(map.resolution > 0.0) || !std::isfinite(map.resolution))
     throw InputError("map", "resolution must be positive");
 }

@@ -11,6 +11,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "hidden_rooms/input_error.h"
+#include "hidden_rooms/range_scan.h"
 
 namespace hidden_rooms {
 
@@ -19,13 +20,6 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kMinPieceSize = 0.01;  // metres: thinner or shorter pieces are dropped (Box2D welds vertices)
 constexpr int8_t kOccupiedThreshold = 65;  // map_saver's: cells at or above are solid
-
-double wrapAngle(double angle) { return std::atan2(std::sin(angle), std::cos(angle)); }
-
-Pose2 compose(const Pose2& a, const Pose2& b) {
-  const double c = std::cos(a.yaw), s = std::sin(a.yaw);
-  return {a.x + c * b.x - s * b.y, a.y + s * b.x + c * b.y, wrapAngle(a.yaw + b.yaw)};
-}
 
 bool finite(const Pose2& pose) { return std::isfinite(pose.x) && std::isfinite(pose.y) && std::isfinite(pose.yaw); }
 
@@ -477,7 +471,7 @@ void Simulation::step() {
   const double dx = after.x - before.x, dy = after.y - before.y;
   const Pose2 motion{c * dx + s * dy, -s * dx + c * dy, wrapAngle(after.yaw - before.yaw)};
   velocity_ = {motion.x / dt, motion.yaw / dt};
-  odometry_ = compose(odometry_, {motion.x * (1.0 + odometry_error_[0]), motion.y * (1.0 + odometry_error_[1]),
+  odometry_ = composePoses(odometry_, {motion.x * (1.0 + odometry_error_[0]), motion.y * (1.0 + odometry_error_[1]),
                                   motion.yaw * (1.0 + odometry_error_[2])});
 }
 
@@ -490,7 +484,7 @@ Pose2 Simulation::truePose() const {
   return {position.x, position.y, wrapAngle(robot_->GetAngle())};
 }
 
-Pose2 Simulation::laserPose() const { return compose(truePose(), options_.laser.mount); }
+Pose2 Simulation::laserPose() const { return composePoses(truePose(), options_.laser.mount); }
 
 Pose2 Simulation::odometryPose() const { return odometry_; }
 

@@ -22,13 +22,13 @@ import tempfile
 import threading
 import time
 
-PACKAGE_NAME = "hidden_rooms"
+from hidden_rooms.package_tools import ToolError, find_binary, tool_error
+
 TOOL_NAME = "batch_cases"
 RESULTS_NAME = "results.csv"
 SETTINGS_NAME = "batch_settings.json"
 LOCK_NAME = ".batch_analysis.lock"
 ALL_METHODS = ["default", "thesis", "unstructured", "structured", "skewnormal"]
-REPO_DIR = os.path.dirname(os.path.dirname(os.path.dirname(os.path.realpath(__file__))))
 STDERR_EXCERPT_CHARS = 2000
 
 # Size classes by number of closable doors (METHOD.md §8, the thesis's classes).
@@ -37,7 +37,7 @@ MEDIUM_MAX_CLOSABLE = 15   # medium: 10 to 15; large: 16 or more
 SIZE_CLASSES = ["small", "medium", "large"]
 
 
-class BatchError(Exception):
+class BatchError(ToolError):
     """Unusable arguments or input (exit code 2)."""
 
 
@@ -82,29 +82,6 @@ def methods_of(columns):
 
 # --------------------------------------------------------------------------------------------------------
 # The C++ tool
-
-
-def find_binary(name=TOOL_NAME, explicit=None):
-    """Path of one of the package's executables: `explicit`, else $CMAKE_PREFIX_PATH's lib/hidden_rooms, else the
-    checkout's .ws workspace."""
-    if explicit:
-        if not (os.path.isfile(explicit) and os.access(explicit, os.X_OK)):
-            raise BatchError("--binary %s is not an executable file" % explicit)
-        return explicit
-    candidates = [os.path.join(prefix, "lib", PACKAGE_NAME, name)
-                  for prefix in os.environ.get("CMAKE_PREFIX_PATH", "").split(os.pathsep) if prefix]
-    candidates.append(os.path.join(REPO_DIR, ".ws", "devel", "lib", PACKAGE_NAME, name))
-    for candidate in candidates:
-        if os.path.isfile(candidate) and os.access(candidate, os.X_OK):
-            return candidate
-    raise BatchError("%s not found; looked in:\n  %s\nBuild the workspace and source its devel/setup.bash, or "
-                     "pass --binary PATH" % (name, "\n  ".join(candidates)))
-
-
-def tool_error(result, what):
-    """The tool's own one-line message (stderr), else its exit code."""
-    message = (result.stderr or "").strip().splitlines()
-    return message[-1] if message else "%s failed with exit code %d" % (what, result.returncode)
 
 
 class Environment:
@@ -466,7 +443,7 @@ def main(argv=None):
                     "keep_dir": os.path.abspath(os.path.join(args.out, "cases")) if args.keep_cases else None}
         check_settings(args.out, settings)
         results = ResultsFile(os.path.join(args.out, RESULTS_NAME), result_columns(args.method_list))
-    except BatchError as error:
+    except ToolError as error:
         print("batch_analysis: error: %s" % error, file=sys.stderr)
         return 2
 
@@ -515,7 +492,7 @@ def main(argv=None):
             failures = run_dask(tasks, args.scheduler, on_row)
         else:
             failures = run_local(tasks, args.jobs, on_row)
-    except BatchError as error:
+    except ToolError as error:
         progress.close()
         print("batch_analysis: error: %s" % error, file=sys.stderr)
         return 2

@@ -1,11 +1,14 @@
 #include "hidden_rooms/ros/room_predictor.h"
 
 #include <cstdio>
+#include <filesystem>
 
+#include <boost/make_shared.hpp>
 #include <visualization_msgs/MarkerArray.h>
 
 #include "hidden_rooms/input_error.h"
 #include "hidden_rooms/layout.h"
+#include "hidden_rooms/octomap_io.h"
 #include "hidden_rooms/prediction_support.h"
 #include "hidden_rooms/ros/conversions.h"
 
@@ -19,6 +22,16 @@ RoomPredictorOptions readRoomPredictorOptions(const ros::NodeHandle& private_nh)
   private_nh.param("predict_on_map", options.predict_on_map, options.predict_on_map);
   private_nh.param("publish_debug", options.publish_debug, options.publish_debug);
   private_nh.param("frame_id", options.frame_id, options.frame_id);
+  private_nh.param("octomap_file", options.octomap_file, options.octomap_file);
+  private_nh.param("octomap_z_min", options.octomap_z_min, options.octomap_z_min);
+  private_nh.param("octomap_z_max", options.octomap_z_max, options.octomap_z_max);
+  private_nh.param("octomap_out", options.octomap_out, options.octomap_out);
+  private_nh.param("octomap_height", options.octomap_height, options.octomap_height);
+  private_nh.param("max_doors", options.max_doors, options.max_doors);
+  private_nh.param("max_map_cells", options.max_map_cells, options.max_map_cells);
+  if (!(options.octomap_height > 0.0)) throw InputError("~octomap_height", "must be positive");
+  if (options.max_doors < 1 || options.max_map_cells < 1)
+    throw InputError("~max_doors, ~max_map_cells", "must be at least 1");
   if (options.predict_on_map && options.closed_doors_file.empty())
     throw InputError(private_nh.getNamespace(), "~predict_on_map needs ~closed_doors_file");
   return options;
@@ -37,6 +50,22 @@ RoomPredictorNode::RoomPredictorNode(ros::NodeHandle nh, const RoomPredictorOpti
   markers_publisher_ = nh.advertise<visualization_msgs::MarkerArray>("predicted_rooms", 1, true);
   service_ = nh.advertiseService("predict_rooms", &RoomPredictorNode::predictRooms, this);
   map_subscriber_ = nh.subscribe("map", 1, &RoomPredictorNode::receiveMap, this);
+  if (!options_.octomap_out.empty()) {
+    const std::filesystem::path folder = std::filesystem::path(options_.octomap_out).parent_path();
+    std::error_code error;
+    if (!folder.empty()) std::filesystem::create_directories(folder, error);
+    if (error) throw InputError(options_.octomap_out, "its folder cannot be created: " + error.message());
+  }
+  if (!options_.octomap_file.empty()) {
+    SliceOptions slice;
+    slice.z_min = options_.octomap_z_min;
+    slice.z_max = options_.octomap_z_max;
+    const OccupancyGrid sliced = sliceOctomap(options_.octomap_file, slice);
+    auto message = boost::make_shared<nav_msgs::OccupancyGrid>(toRos(sliced, options_.frame_id, ros::Time(0)));
+    // Handled like a map from the topic once the node spins (predict_on_map predicts on it then).
+    octomap_timer_ = nh.createWallTimer(
+        ros::WallDuration(0.01), [this, message](const ros::WallTimerEvent&) { receiveMap(message); }, true);
+  }
 }
 
 void RoomPredictorNode::receiveMap(const nav_msgs::OccupancyGrid::ConstPtr& map) {
@@ -68,6 +97,13 @@ void RoomPredictorNode::predict(const PredictRooms::Request& request, PredictRoo
   if (!own_map && latest_map_ == nullptr)
     throw InputError("map", "the request has no map and none was received on " + map_topic_ + " yet");
   const nav_msgs::OccupancyGrid& map_message = own_map ? request.map : *latest_map_;
+  const double cells = static_cast<double>(map_message.info.width) * map_message.info.height;
+  if (cells > options_.max_map_cells)
+    throw InputError("map", std::to_string(map_message.info.width) + " x " + std::to_string(map_message.info.height) +
+                                " cells is more than ~max_map_cells (" + std::to_string(options_.max_map_cells) + ")");
+  if (request.doors.size() > static_cast<size_t>(options_.max_doors))
+    throw InputError("doors", std::to_string(request.doors.size()) + " doors is more than ~max_doors (" +
+                                  std::to_string(options_.max_doors) + ")");
   const std::string frame = map_message.header.frame_id.empty() ? options_.frame_id : map_message.header.frame_id;
 
   PredictionRequest core;
@@ -124,6 +160,17 @@ void RoomPredictorNode::predict(const PredictRooms::Request& request, PredictRoo
     markers.markers.insert(markers.markers.end(), debug.markers.begin(), debug.markers.end());
   }
   markers_publisher_.publish(markers);
+
+  if (!options_.octomap_out.empty()) {
+    ExtrusionOptions extrusion;
+    extrusion.height = options_.octomap_height;
+    try {
+      exportOctomap(completed, labels, extrusion, options_.octomap_out);
+    } catch (const InputError& error) {
+      response->success = false;
+      response->message += "; but the 3D map was not written: " + std::string(error.what());
+    }
+  }
 }
 
 }  // namespace hidden_rooms

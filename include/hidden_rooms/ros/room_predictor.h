@@ -23,17 +23,27 @@ struct RoomPredictorOptions {
   bool predict_on_map = false;     // predict the file's doors again whenever a new map arrives on `map`
   bool publish_debug = false;      // add the layout analysis to predicted_rooms (extended lines, IN/OUT cells)
   std::string frame_id = "map";    // frame of outputs when the map message has an empty header.frame_id
+  std::string octomap_file;        // 3D map source (.bt/.ot): its band [octomap_z_min, octomap_z_max] sliced
+                                   // into the map predicted on until one arrives on `map`; "" = none
+  double octomap_z_min = 0.1;      // metres
+  double octomap_z_max = 2.0;      // metres
+  std::string octomap_out;         // after each prediction, the completed map extruded to this .ot/.bt; "" = off
+  double octomap_height = 2.5;     // metres, height of the extruded walls
+  // Requests beyond these are refused (bounded answer times and memory).
+  int max_doors = 500;
+  int max_map_cells = 25000000;    // 5000 x 5000 cells: 250 m x 250 m at 0.05 m
 };
 
-// Reads the options from the private node handle. Throws InputError for ~predict_on_map without doors.
+// Reads the options from the private node handle. Throws InputError for ~predict_on_map without doors or a
+// bad octomap option.
 RoomPredictorOptions readRoomPredictorOptions(const ros::NodeHandle& private_nh);
 
 // Serves `predict_rooms` (PredictRooms) over the latest map of `map` or the request's own map, and publishes
 // each prediction, latched, as `predicted_map` (the completed map) and `predicted_rooms` (rviz markers).
 class RoomPredictorNode {
  public:
-  // Checks the method and loads the doors and parameters files (throws InputError naming a bad one); does not
-  // wait for anything.
+  // Checks the method, loads the doors and parameters files and slices ~octomap_file (throws InputError naming
+  // a bad one); does not wait for anything.
   RoomPredictorNode(ros::NodeHandle nh, const RoomPredictorOptions& options);
 
   // The service: never throws; every failure is success = false with a message.
@@ -53,6 +63,7 @@ class RoomPredictorNode {
   ros::Publisher predicted_map_publisher_;
   ros::Publisher markers_publisher_;
   ros::ServiceServer service_;
+  ros::WallTimer octomap_timer_;
 };
 
 }  // namespace hidden_rooms

@@ -1,0 +1,54 @@
+#pragma once
+
+#include <fstream>
+#include <string>
+
+#include <nav_msgs/Odometry.h>
+#include <ros/ros.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_listener.h>
+
+namespace hidden_rooms {
+
+// Parameters of the pose_logger node (all private, ~name; see README.md).
+struct PoseLoggerOptions {
+  std::string estimate_log = "poses_map.log";   // tf map_frame -> base_frame, one line per period
+  std::string ground_truth_log;                 // base_pose_ground_truth at the same period; "" = not logged
+  std::string map_frame = "map";
+  std::string base_frame = "base_link";
+  std::string ground_truth_topic = "base_pose_ground_truth";
+  double period = 0.1;                          // seconds of ROS time between logged poses
+};
+
+// Reads the options from the private node handle; throws InputError for a bad value.
+PoseLoggerOptions readPoseLoggerOptions(const ros::NodeHandle& private_nh);
+
+// The thesis's tf listener: logs the robot's pose in the map (tf map -> base_link) at every multiple of `period`
+// of ROS time and, optionally, its true pose (nav_msgs/Odometry on base_pose_ground_truth) every `period`, into
+// pose logs (pose_log.h) flushed line by line so a killed run keeps what it logged.
+class PoseLogger {
+ public:
+  // Opens the logs (throws InputError when one cannot be written); does not wait for tf or messages.
+  PoseLogger(ros::NodeHandle nh, const PoseLoggerOptions& options);
+
+  long long estimatesLogged() const { return estimates_logged_; }
+  long long groundTruthLogged() const { return ground_truth_logged_; }
+
+ private:
+  void onTimer(const ros::TimerEvent& event);
+  void onGroundTruth(const nav_msgs::Odometry::ConstPtr& message);
+
+  PoseLoggerOptions options_;
+  std::ofstream estimate_log_;
+  std::ofstream ground_truth_log_;
+  tf2_ros::Buffer tf_buffer_;
+  tf2_ros::TransformListener tf_listener_;
+  ros::Subscriber ground_truth_subscriber_;
+  ros::Timer timer_;
+  double next_estimate_time_ = 0.0;  // next grid time to log (seconds); 0 = not started
+  ros::Time last_ground_truth_stamp_;
+  long long estimates_logged_ = 0;
+  long long ground_truth_logged_ = 0;
+};
+
+}  // namespace hidden_rooms

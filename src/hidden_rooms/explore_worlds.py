@@ -1,0 +1,355 @@
+"""The thesis's exploration script (METHOD.md §10, thesis §5.1.5): explore simulated worlds with some doors closed.
+
+Per world, in its own ROS master on a free port (so several worlds run side by side): exploration_run.launch
+(simulator, mapper, explorer, pose_logger, optionally a bag recorder). Every --timeout seconds of simulated time
+the map is saved (DIR/WORLD/maps/map_NNN); the run stops when the explorer reports done, when a saved map grew
+by less than --growth over the one before, or at --max-time. Then the final map, the closed doors translated
+into the map frame (translate_doors, METHOD.md §2), the run's scores against its world and, with --method, the
+predicted rooms and their IoU are written. DIR/summary.csv has one row per world.
+
+`scripts/explore_worlds` is the command line (see `main`); each world runs in a worker process
+(`--worker`) whose ROS_MASTER_URI names its own master.
+"""
+import argparse
+import concurrent.futures
+import csv
+import glob
+import json
+import os
+import signal
+import socket
+import subprocess
+import sys
+import time
+
+import numpy as np
+import yaml
+
+from hidden_rooms.package_tools import ToolError, find_binary, tool_error
+
+SUMMARY_NAME = "summary.csv"
+RESULT_NAME = "result.json"
+SUMMARY_COLUMNS = ["world", "status", "closed_doors", "sim_time_s", "wall_time_s", "path_length_m", "coverage",
+                   "free_iou", "worst_door_error_m", "mean_iou", "message"]
+MASTER_START_TIMEOUT = 60.0   # wall seconds for roslaunch's master and the simulator's clock
+STALL_TIMEOUT = 60.0          # wall seconds without simulated time advancing: the run is stuck
+SHUTDOWN_TIMEOUT = 20.0       # wall seconds for roslaunch to stop after SIGINT
+
+
+def free_port():
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as probe:
+        probe.bind(("127.0.0.1", 0))
+        return probe.getsockname()[1]
+
+
+def world_files(paths):
+    """Environment XMLs named by `paths` (files, or folders whose *.xml are taken), in order, without repeats."""
+    files = []
+    for path in paths:
+        if os.path.isdir(path):
+            found = sorted(glob.glob(os.path.join(path, "*.xml")))
+            if not found:
+                raise ToolError("%s: no environment XML (*.xml) in this folder" % path)
+            files.extend(found)
+        elif os.path.isfile(path):
+            files.append(path)
+        else:
+            raise ToolError("%s: no such file or folder" % path)
+    unique = []
+    for path in (os.path.realpath(f) for f in files):
+        if path not in unique:
+            unique.append(path)
+    return unique
+
+
+def world_name(path):
+    return os.path.splitext(os.path.basename(path))[0]
+
+
+# --------------------------------------------------------------------------------------------------------
+# One world (worker process, with its own ROS master)
+
+
+class Run:
+    """Talks to one exploration_run.launch through rospy: simulated time, the explorer's status, map saving."""
+
+    def __init__(self, name):
+        import rospy
+        from nav_msgs.msg import OccupancyGrid
+        from std_msgs.msg import Bool
+        self.rospy = rospy
+        rospy.init_node("explore_worlds_" + name.replace("-", "_"), anonymous=True, disable_signals=True)
+        self.done = False
+        self.free_cells = 0
+        rospy.Subscriber("exploration_done", Bool, self._on_done, queue_size=1)
+        rospy.Subscriber("map", OccupancyGrid, self._on_map, queue_size=1)
+
+    def _on_done(self, message):
+        self.done = self.done or message.data
+
+    def _on_map(self, message):
+        cells = np.asarray(message.data, dtype=np.int8)
+        self.free_cells = int(np.count_nonzero((cells >= 0) & (cells <= 19)))
+
+    def sim_time(self):
+        return self.rospy.get_time()
+
+    def save_map(self, prefix):
+        """Writes PREFIX.yaml/.pgm through the mapper's save_map; returns the number of free cells of the map."""
+        from hidden_rooms.srv import SaveMap
+        service = self.rospy.ServiceProxy("save_map", SaveMap)
+        service.wait_for_service(timeout=30.0)
+        response = service(prefix=prefix)
+        if not response.success:
+            raise RuntimeError("save_map: %s" % response.message)
+        return self.free_cells
+
+
+def wait_for_master(launch, deadline):
+    import rosgraph
+    while time.monotonic() < deadline:
+        if launch.poll() is not None:
+            raise RuntimeError("roslaunch exited with code %d before the master came up" % launch.returncode)
+        if rosgraph.Master("/explore_worlds").is_online():
+            return
+        time.sleep(0.5)
+    raise RuntimeError("no ROS master after %.0f s" % MASTER_START_TIMEOUT)
+
+
+def stop_launch(launch):
+    if launch.poll() is None:
+        launch.send_signal(signal.SIGINT)
+        try:
+            launch.wait(timeout=SHUTDOWN_TIMEOUT)
+        except subprocess.TimeoutExpired:
+            os.killpg(launch.pid, signal.SIGKILL)
+            launch.wait()
+
+
+def explore(args, out_dir, log):
+    """Runs the launch until a stop criterion; returns (status, simulated seconds). Maps go to out_dir."""
+    maps_dir = os.path.join(out_dir, "maps")
+    os.makedirs(maps_dir, exist_ok=True)
+    command = ["roslaunch", "-p", os.environ["ROS_MASTER_URI"].rsplit(":", 1)[1], "hidden_rooms",
+               "exploration_run.launch", "world:=%s" % args.world, "out_dir:=%s" % out_dir,
+               "closed_doors:=%s" % args.closed, "realtime_factor:=%g" % args.realtime_factor,
+               "seed:=%d" % args.seed, "gui:=%s" % ("true" if args.gui else "false")]
+    if args.bag:
+        command.append("bag:=%s" % os.path.join(out_dir, "run.bag"))
+    launch = subprocess.Popen(command, stdout=log, stderr=subprocess.STDOUT, start_new_session=True)
+    try:
+        wait_for_master(launch, time.monotonic() + MASTER_START_TIMEOUT)
+        run = Run(world_name(args.world))
+        status, last_free, saved = None, None, 0
+        next_save = args.timeout
+        last_sim, last_progress = 0.0, time.monotonic()
+        while status is None:
+            time.sleep(0.2)
+            if launch.poll() is not None:
+                raise RuntimeError("roslaunch exited with code %d during the run (see %s)"
+                                   % (launch.returncode, log.name))
+            now = run.sim_time()
+            if now > last_sim:
+                last_sim, last_progress = now, time.monotonic()
+            elif time.monotonic() - last_progress > STALL_TIMEOUT:
+                raise RuntimeError("simulated time stopped at %.1f s" % now)
+            if run.done:
+                status = "done"
+            elif now >= args.max_time:
+                status = "max_time"
+            elif now >= next_save:
+                saved += 1
+                free = run.save_map(os.path.join(maps_dir, "map_%03d" % saved))
+                if last_free and free - last_free < args.growth * last_free:
+                    status = "no_growth"
+                last_free, next_save = free, next_save + args.timeout
+        run.save_map(os.path.join(out_dir, "map"))
+        return status, run.sim_time()
+    finally:
+        stop_launch(launch)
+
+
+def post_process(args, out_dir, result):
+    """translate_doors (doors.yaml, true_rooms.png, exploration.yaml) and the prediction with its scores."""
+    translate = [find_binary("translate_doors"), "--environment", args.world, "--closed", args.closed,
+                 "--truth", os.path.join(out_dir, "poses_truth.log"),
+                 "--estimate", os.path.join(out_dir, "poses_map.log"),
+                 "--map", os.path.join(out_dir, "map.yaml"), "--out", out_dir]
+    completed = subprocess.run(translate, capture_output=True, text=True)
+    if completed.returncode != 0:
+        raise RuntimeError(tool_error(completed, "translate_doors"))
+    with open(os.path.join(out_dir, "exploration.yaml")) as report_file:
+        report = yaml.safe_load(report_file)
+    doors = report.get("doors") or []
+    result.update(path_length_m=report["path_length"], coverage=report["coverage"], free_iou=report["free_iou"],
+                  closed_doors=len(doors),
+                  worst_door_error_m=max((door["error"] for door in doors), default=""))
+    if args.method and doors:
+        predict = [find_binary("predict_rooms_offline"), "--map", os.path.join(out_dir, "map.yaml"),
+                   "--doors", os.path.join(out_dir, "doors.yaml"), "--method", args.method,
+                   "--gt-rooms", os.path.join(out_dir, "true_rooms.png"),
+                   "--out", os.path.join(out_dir, "prediction")]
+        completed = subprocess.run(predict, capture_output=True, text=True)
+        if completed.returncode != 0:
+            raise RuntimeError(tool_error(completed, "predict_rooms_offline"))
+        with open(os.path.join(out_dir, "prediction", "metrics.yaml")) as metrics_file:
+            result["mean_iou"] = yaml.safe_load(metrics_file)["mean_iou"]
+
+
+def load_pose_log(path):
+    """Poses of a pose log (pose_log.h) as an N x 4 array: time, x, y, yaw."""
+    return np.loadtxt(path, comments="#", ndmin=2)
+
+
+def draw_trajectory(out_dir):
+    """DIR/overlay.png: the prediction's overlay (predicted rooms tinted, true rooms outlined) or the explored map,
+    with the robot's estimated trajectory (blue) and the closed doors (red) drawn on it."""
+    import cv2
+    with open(os.path.join(out_dir, "map.yaml")) as map_file:
+        meta = yaml.safe_load(map_file)
+    picture_path = os.path.join(out_dir, "prediction", "overlay.png")
+    picture = cv2.imread(picture_path if os.path.isfile(picture_path) else
+                         os.path.join(out_dir, meta["image"]), cv2.IMREAD_COLOR)
+    if picture is None:
+        raise RuntimeError("%s: no picture of the map to draw on" % out_dir)
+    resolution, origin = float(meta["resolution"]), meta["origin"]
+
+    def pixels(x, y):
+        return np.stack([(np.asarray(x) - origin[0]) / resolution,
+                         picture.shape[0] - (np.asarray(y) - origin[1]) / resolution], axis=-1)
+
+    poses = load_pose_log(os.path.join(out_dir, "poses_map.log"))
+    path = np.round(pixels(poses[:, 1], poses[:, 2])).astype(np.int32)
+    cv2.polylines(picture, [path.reshape(-1, 1, 2)], False, (200, 80, 0), 1, cv2.LINE_AA)
+    cv2.circle(picture, tuple(int(v) for v in path[0]), 4, (200, 80, 0), -1)
+    doors_path = os.path.join(out_dir, "doors.yaml")
+    if os.path.isfile(doors_path):
+        with open(doors_path) as doors_file:
+            doors = yaml.safe_load(doors_file).get("doors") or []
+        for door in doors:
+            centre = pixels(*door["position"])
+            half = 0.5 * door["width"] / resolution
+            along_x = door["orientation"] == "O"
+            offset = np.array([half, 0.0]) if along_x else np.array([0.0, half])
+            a, b = np.round(centre - offset).astype(int), np.round(centre + offset).astype(int)
+            cv2.line(picture, tuple(int(v) for v in a), tuple(int(v) for v in b), (0, 0, 220), 3)
+            cv2.putText(picture, str(door["id"]), tuple(int(v) for v in b + 3), cv2.FONT_HERSHEY_SIMPLEX, 0.4,
+                        (0, 0, 220), 1, cv2.LINE_AA)
+    cv2.imwrite(os.path.join(out_dir, "overlay.png"), picture)
+
+
+def run_worker(args):
+    """One world, start to end; writes out_dir/result.json and returns 0 when the run was usable."""
+    out_dir = os.path.join(args.out, world_name(args.world))
+    os.makedirs(out_dir, exist_ok=True)
+    result = {"world": args.world, "status": "failed", "closed_doors": "", "sim_time_s": "", "wall_time_s": "",
+              "path_length_m": "", "coverage": "", "free_iou": "", "worst_door_error_m": "", "mean_iou": "",
+              "message": ""}
+    started = time.monotonic()
+    with open(os.path.join(out_dir, "launch.log"), "w") as log:
+        try:
+            status, sim_time = explore(args, out_dir, log)
+            result.update(status=status, sim_time_s=round(sim_time, 1))
+            result["wall_time_s"] = round(time.monotonic() - started, 1)
+            post_process(args, out_dir, result)
+            draw_trajectory(out_dir)
+        except (RuntimeError, OSError, ToolError) as error:
+            result["message"] = str(error)
+            result["wall_time_s"] = round(time.monotonic() - started, 1)
+    with open(os.path.join(out_dir, RESULT_NAME), "w") as result_file:
+        json.dump(result, result_file, indent=1)
+    return 0 if result["status"] != "failed" else 1
+
+
+# --------------------------------------------------------------------------------------------------------
+# Command line
+
+
+def parse_arguments(argv):
+    parser = argparse.ArgumentParser(
+        prog="explore_worlds",
+        description="Explore simulated worlds with closed doors (simulator + mapper + explorer), save the maps, "
+                    "the pose logs and the closed doors in the map frame, and predict the hidden rooms.")
+    parser.add_argument("worlds", nargs="+", metavar="WORLDS_DIR|ENV.xml", help="worlds to explore")
+    parser.add_argument("--out", required=True, help="output folder (one subfolder per world)")
+    parser.add_argument("--closed", default="",
+                        help="doors closed in every world: numbers or ids, comma-separated, 'closable' or 'all' "
+                             "(doors with status CLOSED in the file are closed anyway)")
+    parser.add_argument("--timeout", type=float, default=60.0,
+                        help="simulated seconds between saved maps (the thesis's timeout)")
+    parser.add_argument("--growth", type=float, default=0.01,
+                        help="stop when a saved map has less than this fraction more free cells than the last")
+    parser.add_argument("--max-time", type=float, default=1800.0, help="simulated seconds at most per world")
+    parser.add_argument("--realtime-factor", type=float, default=3.0, help="simulated seconds per wall second")
+    parser.add_argument("--seed", type=int, default=0, help="seed of the simulator and the filter")
+    parser.add_argument("--jobs", type=int, default=1, help="worlds explored side by side")
+    parser.add_argument("--method", default="default", help="prediction method on the explored map ('' = none)")
+    parser.add_argument("--bag", action="store_true", help="also record a bag per world (run.bag)")
+    parser.add_argument("--gui", action="store_true", help="show rviz (needs a display; use with --jobs 1)")
+    parser.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
+    args = parser.parse_args(argv)
+    for name in ("timeout", "max_time", "realtime_factor"):
+        if not getattr(args, name) > 0:
+            parser.error("--%s must be positive" % name.replace("_", "-"))
+    if args.jobs < 1:
+        parser.error("--jobs must be at least 1")
+    return args
+
+
+def worker_command(args, world):
+    command = [sys.executable, os.path.realpath(sys.argv[0]), world, "--worker", "--out", args.out,
+               "--closed", args.closed, "--timeout", str(args.timeout), "--growth", str(args.growth),
+               "--max-time", str(args.max_time), "--realtime-factor", str(args.realtime_factor),
+               "--seed", str(args.seed), "--method", args.method]
+    return command + (["--bag"] if args.bag else []) + (["--gui"] if args.gui else [])
+
+
+def explore_one(args, world):
+    """Runs a worker for `world` with its own master; returns its result dictionary."""
+    env = dict(os.environ, ROS_MASTER_URI="http://127.0.0.1:%d" % free_port(),
+               ROS_LOG_DIR=os.path.join(args.out, world_name(world), "ros_log"))
+    out_dir = os.path.join(args.out, world_name(world))
+    os.makedirs(out_dir, exist_ok=True)
+    with open(os.path.join(out_dir, "worker.log"), "w") as log:
+        subprocess.run(worker_command(args, world), env=env, stdout=log, stderr=subprocess.STDOUT)
+    try:
+        with open(os.path.join(out_dir, RESULT_NAME)) as result_file:
+            return json.load(result_file)
+    except (OSError, ValueError):
+        return {"world": world, "status": "failed", "message": "the worker wrote no result (see %s)"
+                % os.path.join(out_dir, "worker.log")}
+
+
+def main(argv=None):
+    args = parse_arguments(sys.argv[1:] if argv is None else argv)
+    try:
+        worlds = world_files(args.worlds)
+        args.out = os.path.realpath(args.out)
+        if args.worker:
+            args.world = worlds[0]
+            return run_worker(args)
+        find_binary("translate_doors")
+        os.makedirs(args.out, exist_ok=True)
+    except ToolError as error:
+        print("explore_worlds: error: %s" % error, file=sys.stderr)
+        return 2
+    results = []
+    with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
+        futures = {pool.submit(explore_one, args, world): world for world in worlds}
+        for future in concurrent.futures.as_completed(futures):
+            result = future.result()
+            results.append(result)
+            print("explore_worlds: %s: %s, %s s simulated in %s s, coverage %s, mean IoU %s %s"
+                  % (world_name(result["world"]), result["status"], result.get("sim_time_s", ""),
+                     result.get("wall_time_s", ""), result.get("coverage", ""), result.get("mean_iou", ""),
+                     result.get("message", "")), flush=True)
+    order = {world: k for k, world in enumerate(worlds)}
+    results.sort(key=lambda result: order.get(result["world"], len(order)))
+    summary = os.path.join(args.out, SUMMARY_NAME)
+    with open(summary + ".tmp", "w", newline="") as summary_file:
+        writer = csv.DictWriter(summary_file, fieldnames=SUMMARY_COLUMNS, extrasaction="ignore", restval="")
+        writer.writeheader()
+        writer.writerows(results)
+    os.replace(summary + ".tmp", summary)
+    print("explore_worlds: summary in %s" % summary)
+    return 0 if all(result["status"] != "failed" for result in results) else 1

@@ -1,0 +1,97 @@
+#include "hidden_rooms/ros/pose_logger.h"
+
+#include <cmath>
+#include <filesystem>
+
+#include <tf2/exceptions.h>
+
+#include "hidden_rooms/input_error.h"
+#include "hidden_rooms/pose_log.h"
+#include "hidden_rooms/ros/conversions.h"
+
+namespace hidden_rooms {
+
+namespace {
+
+constexpr double kGiveUpDelay = 1.0;  // seconds of ROS time after which a pose tf cannot give is skipped
+
+// Opens a log for writing, creating its folder; throws InputError when that fails.
+void openLog(const std::string& path, std::ofstream* log) {
+  const std::filesystem::path folder = std::filesystem::path(path).parent_path();
+  std::error_code error;
+  if (!folder.empty()) std::filesystem::create_directories(folder, error);
+  log->open(path, std::ios::out | std::ios::trunc);
+  if (!*log) throw InputError(path, "cannot be written (pose log)");
+}
+
+}  // namespace
+
+PoseLoggerOptions readPoseLoggerOptions(const ros::NodeHandle& private_nh) {
+  PoseLoggerOptions options;
+  private_nh.param("estimate_log", options.estimate_log, options.estimate_log);
+  private_nh.param("ground_truth_log", options.ground_truth_log, options.ground_truth_log);
+  private_nh.param("map_frame", options.map_frame, options.map_frame);
+  private_nh.param("base_frame", options.base_frame, options.base_frame);
+  private_nh.param("ground_truth_topic", options.ground_truth_topic, options.ground_truth_topic);
+  private_nh.param("period", options.period, options.period);
+  if (!std::isfinite(options.period) || options.period <= 0.0) throw InputError("~period", "must be positive");
+  if (options.estimate_log.empty()) throw InputError("~estimate_log", "must name a file");
+  if (options.map_frame.empty() || options.base_frame.empty())
+    throw InputError("~map_frame, ~base_frame", "must not be empty");
+  return options;
+}
+
+PoseLogger::PoseLogger(ros::NodeHandle nh, const PoseLoggerOptions& options)
+    : options_(options), tf_buffer_(ros::Duration(10.0)), tf_listener_(tf_buffer_) {
+  openLog(options.estimate_log, &estimate_log_);
+  estimate_log_ << poseLogHeader(options.map_frame, options.base_frame) << std::flush;
+  if (!options.ground_truth_log.empty()) {
+    // Its frames are written with the first message (its header names the world frame).
+    openLog(options.ground_truth_log, &ground_truth_log_);
+    ground_truth_subscriber_ = nh.subscribe(options.ground_truth_topic, 100, &PoseLogger::onGroundTruth, this);
+  }
+  timer_ = nh.createTimer(ros::Duration(options.period), &PoseLogger::onTimer, this);
+}
+
+void PoseLogger::onTimer(const ros::TimerEvent&) {
+  // Poses on the grid of multiples of the period, each logged once tf can give it (tf interpolates between the
+  // odometry's and the mapper's transforms around it). A grid time tf still cannot give after
+  // kGiveUpDelay is skipped.
+  const double now = ros::Time::now().toSec();
+  if (now <= 0.0) return;
+  if (next_estimate_time_ <= 0.0) next_estimate_time_ = std::ceil(now / options_.period) * options_.period;
+  while (next_estimate_time_ <= now) {
+    const ros::Time wanted(next_estimate_time_);
+    std::string problem;
+    if (tf_buffer_.canTransform(options_.map_frame, options_.base_frame, wanted, &problem)) {
+      const geometry_msgs::TransformStamped transform =
+          tf_buffer_.lookupTransform(options_.map_frame, options_.base_frame, wanted);
+      estimate_log_ << poseLogLine({next_estimate_time_, fromRos(transform.transform)}) << std::flush;
+      ++estimates_logged_;
+    } else if (now - next_estimate_time_ < kGiveUpDelay) {
+      return;  // the transforms around it may still come
+    } else {
+      ROS_WARN_THROTTLE(10.0, "pose_logger: no %s -> %s at %.2f s: %s", options_.map_frame.c_str(),
+                        options_.base_frame.c_str(), next_estimate_time_, problem.c_str());
+    }
+    next_estimate_time_ += options_.period;
+  }
+}
+
+void PoseLogger::onGroundTruth(const nav_msgs::Odometry::ConstPtr& message) {
+  const ros::Time stamp = message->header.stamp;
+  if (!last_ground_truth_stamp_.isZero() && (stamp - last_ground_truth_stamp_).toSec() < options_.period - 1e-6)
+    return;
+  const Pose2 pose = fromRos(message->pose.pose);
+  if (!std::isfinite(pose.x) || !std::isfinite(pose.y) || !std::isfinite(pose.yaw)) {
+    ROS_WARN_THROTTLE(10.0, "pose_logger: ground-truth pose with a non-finite value dropped");
+    return;
+  }
+  if (ground_truth_logged_ == 0)
+    ground_truth_log_ << poseLogHeader(message->header.frame_id, message->child_frame_id + " (ground truth)");
+  last_ground_truth_stamp_ = stamp;
+  ground_truth_log_ << poseLogLine({stamp.toSec(), pose}) << std::flush;
+  ++ground_truth_logged_;
+}
+
+}  // namespace hidden_rooms

@@ -1,0 +1,138 @@
+// translate_doors --environment ENV.xml --closed SPEC --truth GT.log --estimate MAP.log --out DIR [--map MAP.yaml]:
+// the closed doors of a simulated exploration placed in the map the robot built (METHOD.md §2) and, with the
+// map, the run scored against the world it explored.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <limits>
+
+#include <opencv2/imgproc.hpp>
+
+#include "hidden_rooms/command_line.h"
+#include "hidden_rooms/door_translation.h"
+#include "hidden_rooms/input_error.h"
+#include "hidden_rooms/map_quality.h"
+#include "hidden_rooms/range_scan.h"
+
+namespace po = boost::program_options;
+using namespace hidden_rooms;
+
+namespace {
+
+// Distance (metres) of every cell of `map` to its nearest occupied cell (a large value when there is none).
+cv::Mat1f distanceToOccupied(const OccupancyGrid& map) {
+  cv::Mat1b not_occupied(map.height(), map.width());
+  for (int row = 0; row < map.height(); ++row)
+    for (int col = 0; col < map.width(); ++col) not_occupied(row, col) = map.cells(row, col) >= 65 ? 0 : 255;
+  cv::Mat1f distance;
+  cv::distanceTransform(not_occupied, distance, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+  return distance * map.resolution;
+}
+
+int run(int argc, char** argv) {
+  po::options_description options("Options");
+  std::string environment_path, closed_spec, truth_path, estimate_path, map_path, out_dir;
+  double door_width = 0.9;
+  RenderOptions render_options;
+  options.add_options()
+      ("environment", po::value(&environment_path)->required(), "environment XML the robot explored")
+      ("closed", po::value(&closed_spec)->default_value(""),
+       "doors that were closed (as the simulator's ~closed_doors); doors with status CLOSED are added; "
+       "only those hiding a room (closable) are written")
+      ("truth", po::value(&truth_path)->required(), "true pose log (world frame, pose_logger's ground truth)")
+      ("estimate", po::value(&estimate_path)->required(), "estimated pose log (map -> base_link, pose_logger)")
+      ("out", po::value(&out_dir)->required(), "output folder (created)")
+      ("map", po::value(&map_path), "the explored map (map_server yaml): also score the run")
+      ("door-width", po::value(&door_width)->default_value(0.9), "width written for every door, metres")
+      ("wall-thickness", po::value<double>(), "wall thickness as simulated, metres (default: the world's)");
+  po::positional_options_description positional;
+  po::variables_map values;
+  if (!parseCommandLine(argc, argv,
+                        "Usage: translate_doors --environment ENV.xml --closed SPEC --truth GT.log --estimate MAP.log\n"
+                        "                       --out DIR [--map MAP.yaml]\n"
+                        "Writes DIR/doors.yaml: the closed doors in the map frame, each carried over from the world\n"
+                        "by the robot pose closest to it (METHOD.md 2). With --map also DIR/true_rooms.png (label k =\n"
+                        "the room behind the k-th door, in the map's grid) and DIR/exploration.yaml: coverage of the\n"
+                        "reachable free area, map quality, path length and each door's translation error.",
+                        options, positional, &values))
+    return kExitOk;
+  if (!(door_width > 0.0)) throw InputError("--door-width", "must be positive");
+  if (values.count("wall-thickness")) render_options.wall_thickness = values["wall-thickness"].as<double>();
+  render_options.door_width = door_width;
+
+  const Environment environment = loadEnvironment(environment_path);
+  const std::set<int> closed = parseDoorSelection(environment, closed_spec, "--closed");
+  const RenderedEnvironment rendered = renderEnvironment(environment, closed, render_options);
+  // The closed doors that hide a room (closable): a closed door of a room with another door hides nothing.
+  std::vector<int> door_indices;
+  for (const MapDoor& door : rendered.closed_doors.doors) {
+    const int index = environment.findDoor(std::to_string(door.id));
+    if (roomBehindDoor(environment, index) >= 0)
+      door_indices.push_back(index);
+    else
+      std::cout << "translate_doors: door " << door.id << " is closed but hides no room (its other side has more "
+                << "doors); not written" << std::endl;
+  }
+  const PoseLog truth = loadPoseLog(truth_path);
+  const PoseLog estimate = loadPoseLog(estimate_path);
+
+  const DoorsFile doors = translateDoors(environment, door_indices, truth.poses, estimate.poses, door_width);
+  createOutputDirectory(out_dir);
+  const std::filesystem::path out(out_dir);
+  saveDoors(doors, (out / "doors.yaml").string());
+  std::cout << "translate_doors: " << doors.doors.size() << " closed doors -> " << (out / "doors.yaml").string()
+            << std::endl;
+  if (map_path.empty()) return kExitOk;
+
+  // Scoring: the world placed in the map frame by the least-squares fit of the two trajectories.
+  const OccupancyGrid map = loadMap(map_path);
+  const Pose2 world_from_map = fitWorldFromMap(truth.poses, estimate.poses);
+  const Pose2 start = truth.poses.front().pose;
+  const cv::Mat1b reachable = reachableFreeArea(rendered.map, Point2(start.x, start.y));
+  const MapQuality quality = evaluateMap(map, world_from_map, rendered.map, reachable);
+  const cv::Mat1w true_rooms = trueRoomsInMap(environment, door_indices, spaceLabelsInMap(rendered, map, world_from_map));
+  saveLabelImage(true_rooms, (out / "true_rooms.png").string());
+
+  const double coverage =
+      quality.true_free_cells ? double(quality.intersection_cells) / double(quality.true_free_cells) : 0.0;
+  const cv::Mat1f wall_distance = distanceToOccupied(map);
+  std::ofstream report((out / "exploration.yaml").string());
+  report << std::fixed << std::setprecision(4);
+  report << "# translate_doors: the run against its world (world frame = the environment's)\n"
+         << "world_from_map: [" << world_from_map.x << ", " << world_from_map.y << ", " << world_from_map.yaw << "]\n"
+         << "coverage: " << coverage
+         << "  # mapped free / reachable free (true free cells reachable from the start)\n"
+         << "free_iou: " << quality.free_iou << "\n"
+         << "walls_within_2_cells: " << quality.walls_within_2_cells << "\n"
+         << "path_length: " << pathLength(truth.poses) << "  # metres, true trajectory\n"
+         << "duration: " << truth.poses.back().time - truth.poses.front().time << "  # seconds of the run's clock\n"
+         << "doors:\n";
+  double worst_error = 0.0;
+  for (size_t k = 0; k < doors.doors.size(); ++k) {
+    const Door& door = environment.doors[door_indices[k]];
+    const Point2 fitted = transformPoint(invertPose(world_from_map), door.centre);
+    const double error = (doors.doors[k].position - fitted).norm();
+    int col = 0, row = 0;
+    const double to_wall =
+        map.cellOf(doors.doors[k].position, &col, &row) ? wall_distance(row, col) : std::numeric_limits<double>::infinity();
+    worst_error = std::max(worst_error, error);
+    report << "  - {id: " << door.number << ", position: [" << doors.doors[k].position.x() << ", "
+           << doors.doors[k].position.y() << "], fitted_position: [" << fitted.x() << ", " << fitted.y()
+           << "], error: " << error << ", to_mapped_wall: " << (std::isfinite(to_wall) ? std::to_string(to_wall) : std::string(".inf"))
+           << "}\n";
+  }
+  if (!report) throw InputError((out / "exploration.yaml").string(), "cannot be written");
+  std::cout << "translate_doors: coverage " << std::fixed << std::setprecision(3)
+            << coverage
+            << ", free IoU " << quality.free_iou << ", worst door error " << worst_error << " m -> "
+            << (out / "exploration.yaml").string() << std::endl;
+  return kExitOk;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return runTool("translate_doors", [&] { return run(argc, argv); });
+}

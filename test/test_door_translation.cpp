@@ -1,0 +1,146 @@
+// Pose logs, the door translation of METHOD.md §2, trajectory alignment and the truth moved into a map's grid.
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "hidden_rooms/door_translation.h"
+#include "hidden_rooms/input_error.h"
+#include "hidden_rooms/range_scan.h"
+
+namespace hidden_rooms {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// A robot driving an arc in the world, and the same run as the SLAM estimate in a map frame placed at
+// `world_from_map`.
+void arcRun(const Pose2& world_from_map, std::vector<TimedPose>* truth, std::vector<TimedPose>* estimate) {
+  const Pose2 map_from_world = invertPose(world_from_map);
+  for (int k = 0; k <= 200; ++k) {
+    const double t = 0.1 * k;
+    const Pose2 world{2.0 + 3.0 * std::cos(0.1 * t), 1.0 + 3.0 * std::sin(0.1 * t), 0.1 * t + kPi / 2};
+    truth->push_back({t, world});
+    estimate->push_back({t, composePoses(map_from_world, world)});
+  }
+}
+
+TEST(PoseLog, RoundTripsAndReadsFrames) {
+  const std::string text = poseLogHeader("map", "base_link") + poseLogLine({1.0, {1.5, -2.0, 0.25}}) +
+                           poseLogLine({1.1, {1.6, -2.0, 0.3}});
+  const PoseLog log = parsePoseLog(text, "log");
+  EXPECT_EQ(log.parent_frame, "map");
+  EXPECT_EQ(log.child_frame, "base_link");
+  ASSERT_EQ(log.poses.size(), 2u);
+  EXPECT_DOUBLE_EQ(log.poses[0].pose.x, 1.5);
+  EXPECT_DOUBLE_EQ(log.poses[1].pose.yaw, 0.3);
+}
+
+TEST(PoseLog, RejectsBadLogsNamingTheLine) {
+  const auto problem = [](const std::string& text) {
+    try {
+      parsePoseLog(text, "bad.log");
+    } catch (const InputError& error) {
+      return std::string(error.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(problem("# only a comment\n").find("no poses"), std::string::npos);
+  EXPECT_NE(problem("0.0 1 2 3\n0.1 1 2\n").find("line 2"), std::string::npos);
+  EXPECT_NE(problem("0.0 1 2 3 4\n").find("line 1"), std::string::npos);
+  EXPECT_NE(problem("0.0 nan 2 3\n").find("line 1"), std::string::npos);
+  EXPECT_NE(problem("0.2 1 2 3\n0.1 1 2 3\n").find("does not increase"), std::string::npos);
+  EXPECT_THROW(loadPoseLog("/nonexistent/poses.log"), InputError);
+}
+
+TEST(PoseLog, InterpolatesPosesAndYawAcrossPi) {
+  const std::vector<TimedPose> poses{{0.0, {0.0, 0.0, 3.0}}, {1.0, {1.0, 2.0, -3.0}}};
+  const Pose2 middle = poseAt(poses, 0.5);
+  EXPECT_NEAR(middle.x, 0.5, 1e-12);
+  EXPECT_NEAR(middle.y, 1.0, 1e-12);
+  EXPECT_NEAR(std::abs(middle.yaw), kPi, 1e-9);  // through pi, not through 0
+  EXPECT_DOUBLE_EQ(poseAt(poses, -1.0).x, 0.0);
+  EXPECT_DOUBLE_EQ(poseAt(poses, 5.0).x, 1.0);
+  EXPECT_NEAR(pathLength(poses), std::sqrt(5.0), 1e-12);
+}
+
+TEST(DoorTranslation, EqualsTheThesisFormulaWhenFramesAreOnlyShifted) {
+  std::vector<TimedPose> truth, estimate;
+  arcRun({-1.0, 0.5, 0.0}, &truth, &estimate);
+  const Point2 door(4.0, 4.0);
+  const DoorInMap in_map = translateDoor(door, 0.0, truth, estimate);
+  // M_d = M_r(t_min) + (GT_d - GT_r(t_min)) with the closest true pose.
+  size_t closest = 0;
+  for (size_t k = 1; k < truth.size(); ++k)
+    if ((door - Point2(truth[k].pose.x, truth[k].pose.y)).norm() <
+        (door - Point2(truth[closest].pose.x, truth[closest].pose.y)).norm())
+      closest = k;
+  const Point2 thesis = Point2(estimate[closest].pose.x, estimate[closest].pose.y) +
+                        (door - Point2(truth[closest].pose.x, truth[closest].pose.y));
+  EXPECT_NEAR((in_map.position - thesis).norm(), 0.0, 1e-9);
+  EXPECT_NEAR((in_map.position - Point2(5.0, 3.5)).norm(), 0.0, 1e-9);
+  EXPECT_DOUBLE_EQ(in_map.time, truth[closest].time);
+}
+
+TEST(DoorTranslation, FollowsAMapFrameRotatedAgainstTheWorld) {
+  std::vector<TimedPose> truth, estimate;
+  const Pose2 world_from_map{3.0, -2.0, kPi / 2};
+  arcRun(world_from_map, &truth, &estimate);
+  Environment environment;
+  Door door;
+  door.number = 7;
+  door.centre = Point2(4.5, 2.0);
+  door.wall_angle = 0.0;  // the wall runs along the world's x: along the map's y
+  environment.doors.push_back(door);
+  const DoorsFile doors = translateDoors(environment, {0}, truth, estimate, 0.8);
+  ASSERT_EQ(doors.doors.size(), 1u);
+  EXPECT_EQ(doors.doors[0].id, 7);
+  EXPECT_DOUBLE_EQ(doors.doors[0].width, 0.8);
+  EXPECT_EQ(doors.doors[0].orientation, DoorOrientation::kAlongY);
+  const Point2 expected = transformPoint(invertPose(world_from_map), door.centre);
+  EXPECT_NEAR((doors.doors[0].position - expected).norm(), 0.0, 1e-9);
+}
+
+TEST(DoorTranslation, FitsTheWorldFromMapTransform) {
+  std::vector<TimedPose> truth, estimate;
+  const Pose2 world_from_map{3.0, -2.0, 0.7};
+  arcRun(world_from_map, &truth, &estimate);
+  const Pose2 fitted = fitWorldFromMap(truth, estimate);
+  EXPECT_NEAR(fitted.x, 3.0, 1e-9);
+  EXPECT_NEAR(fitted.y, -2.0, 1e-9);
+  EXPECT_NEAR(fitted.yaw, 0.7, 1e-9);
+
+  const std::vector<TimedPose> standing{{0.0, {1.0, 1.0, 0.0}}, {1.0, {1.0, 1.0, 0.0}}};
+  EXPECT_THROW(fitWorldFromMap(standing, standing), InputError);
+  EXPECT_THROW(fitWorldFromMap(truth, {{100.0, {0.0, 0.0, 0.0}}}), InputError);
+}
+
+TEST(DoorTranslation, ReachableFreeCellsStopAtWalls) {
+  OccupancyGrid grid;
+  grid.resolution = 0.1;
+  grid.cells = cv::Mat_<int8_t>(20, 40, OccupancyGrid::kFree);
+  grid.cells.col(20).setTo(OccupancyGrid::kOccupied);  // two rooms, no door
+  grid.cells.row(0).setTo(OccupancyGrid::kUnknown);
+  const cv::Mat1b reachable = reachableFreeArea(grid, Point2(0.55, 1.05));
+  EXPECT_EQ(cv::countNonZero(reachable), 20 * 19);
+  EXPECT_EQ(reachable(5, 30), 0);
+  EXPECT_THROW(reachableFreeArea(grid, Point2(-1.0, 1.0)), InputError);
+}
+
+TEST(DoorTranslation, MovesTheTrueRoomsIntoTheMapGrid) {
+  const Environment environment = loadEnvironment(std::string(HIDDEN_ROOMS_SOURCE_DIR) + "/worlds/small_1.xml");
+  const std::vector<int> closable = closableDoors(environment);
+  ASSERT_FALSE(closable.empty());
+  const RenderedEnvironment rendered = renderEnvironment(environment, {closable.front()});
+  // The map: the same grid placed 1 m further along x in the map frame (world = map - 1 m).
+  OccupancyGrid map = rendered.map;
+  map.origin += Point2(1.0, 0.0);
+  const cv::Mat1w labels = spaceLabelsInMap(rendered, map, Pose2{-1.0, 0.0, 0.0});
+  EXPECT_EQ(cv::countNonZero(labels != rendered.space_labels), 0);
+  const cv::Mat1w rooms = trueRoomsInMap(environment, {closable.front()}, labels);
+  const HiddenRoomsCase hidden = hideClosedRooms(environment, rendered);
+  EXPECT_GT(cv::countNonZero(rooms), 0);
+  EXPECT_EQ(cv::countNonZero(rooms != hidden.true_rooms), 0);
+}
+
+}  // namespace
+}  // namespace hidden_rooms
