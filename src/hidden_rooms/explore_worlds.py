@@ -16,6 +16,7 @@ import csv
 import glob
 import json
 import os
+import random
 import signal
 import socket
 import subprocess
@@ -25,6 +26,7 @@ import time
 import numpy as np
 import yaml
 
+from hidden_rooms import batch_analysis
 from hidden_rooms.package_tools import ToolError, find_binary, tool_error
 
 SUMMARY_NAME = "summary.csv"
@@ -64,6 +66,17 @@ def world_files(paths):
 
 def world_name(path):
     return os.path.splitext(os.path.basename(path))[0]
+
+
+def closed_doors_of(spec, world, seed):
+    """The simulator's closed-doors text for `world`: `spec` itself, or for 'random:N' N of the world's closable
+    doors drawn with `seed` and the world's name (the same doors on every machine and re-run)."""
+    if not spec.startswith("random:"):
+        return spec
+    count = int(spec[len("random:"):])  # checked by parse_arguments
+    closable = batch_analysis.Environment(world, find_binary(batch_analysis.TOOL_NAME)).closable
+    chosen = random.Random("%d/%s" % (seed, world_name(world))).sample(closable, min(count, len(closable)))
+    return ",".join(str(door) for door in sorted(chosen))
 
 
 # --------------------------------------------------------------------------------------------------------
@@ -182,7 +195,6 @@ def post_process(args, out_dir, result):
         report = yaml.safe_load(report_file)
     doors = report.get("doors") or []
     result.update(path_length_m=report["path_length"], coverage=report["coverage"], free_iou=report["free_iou"],
-                  closed_doors=len(doors),
                   worst_door_error_m=max((door["error"] for door in doors), default=""))
     if args.method and doors:
         predict = [find_binary("predict_rooms_offline"), "--map", os.path.join(out_dir, "map.yaml"),
@@ -193,7 +205,7 @@ def post_process(args, out_dir, result):
         if completed.returncode != 0:
             raise RuntimeError(tool_error(completed, "predict_rooms_offline"))
         with open(os.path.join(out_dir, "prediction", "metrics.yaml")) as metrics_file:
-            result["mean_iou"] = yaml.safe_load(metrics_file)["mean_iou"]
+            result["mean_iou"] = round(yaml.safe_load(metrics_file)["mean_iou"], 4)
 
 
 def load_pose_log(path):
@@ -249,7 +261,7 @@ def run_worker(args):
     with open(os.path.join(out_dir, "launch.log"), "w") as log:
         try:
             status, sim_time = explore(args, out_dir, log)
-            result.update(status=status, sim_time_s=round(sim_time, 1))
+            result.update(status=status, sim_time_s=round(sim_time, 1), closed_doors=args.closed)
             result["wall_time_s"] = round(time.monotonic() - started, 1)
             post_process(args, out_dir, result)
             draw_trajectory(out_dir)
@@ -273,14 +285,15 @@ def parse_arguments(argv):
     parser.add_argument("worlds", nargs="+", metavar="WORLDS_DIR|ENV.xml", help="worlds to explore")
     parser.add_argument("--out", required=True, help="output folder (one subfolder per world)")
     parser.add_argument("--closed", default="",
-                        help="doors closed in every world: numbers or ids, comma-separated, 'closable' or 'all' "
-                             "(doors with status CLOSED in the file are closed anyway)")
-    parser.add_argument("--timeout", type=float, default=60.0,
+                        help="doors closed in every world: numbers or ids, comma-separated, 'closable', 'all', or "
+                             "'random:N' for N of each world's closable doors drawn with --seed (doors with status "
+                             "CLOSED in the file are closed anyway)")
+    parser.add_argument("--timeout", type=float, default=120.0,
                         help="simulated seconds between saved maps (the thesis's timeout)")
-    parser.add_argument("--growth", type=float, default=0.01,
+    parser.add_argument("--growth", type=float, default=0.001,
                         help="stop when a saved map has less than this fraction more free cells than the last")
     parser.add_argument("--max-time", type=float, default=1800.0, help="simulated seconds at most per world")
-    parser.add_argument("--realtime-factor", type=float, default=3.0, help="simulated seconds per wall second")
+    parser.add_argument("--realtime-factor", type=float, default=4.0, help="simulated seconds per wall second")
     parser.add_argument("--seed", type=int, default=0, help="seed of the simulator and the filter")
     parser.add_argument("--jobs", type=int, default=1, help="worlds explored side by side")
     parser.add_argument("--method", default="default", help="prediction method on the explored map ('' = none)")
@@ -293,12 +306,15 @@ def parse_arguments(argv):
             parser.error("--%s must be positive" % name.replace("_", "-"))
     if args.jobs < 1:
         parser.error("--jobs must be at least 1")
+    if args.closed.startswith("random:") and not (args.closed[len("random:"):].isdigit() and
+                                                   int(args.closed[len("random:"):]) >= 1):
+        parser.error("--closed %s: expected random:N with a whole number N >= 1" % args.closed)
     return args
 
 
-def worker_command(args, world):
+def worker_command(args, world, closed):
     command = [sys.executable, os.path.realpath(sys.argv[0]), world, "--worker", "--out", args.out,
-               "--closed", args.closed, "--timeout", str(args.timeout), "--growth", str(args.growth),
+               "--closed", closed, "--timeout", str(args.timeout), "--growth", str(args.growth),
                "--max-time", str(args.max_time), "--realtime-factor", str(args.realtime_factor),
                "--seed", str(args.seed), "--method", args.method]
     return command + (["--bag"] if args.bag else []) + (["--gui"] if args.gui else [])
@@ -310,8 +326,12 @@ def explore_one(args, world):
                ROS_LOG_DIR=os.path.join(args.out, world_name(world), "ros_log"))
     out_dir = os.path.join(args.out, world_name(world))
     os.makedirs(out_dir, exist_ok=True)
+    try:
+        closed = closed_doors_of(args.closed, world, args.seed)
+    except ToolError as error:
+        return {"world": world, "status": "failed", "message": str(error)}
     with open(os.path.join(out_dir, "worker.log"), "w") as log:
-        subprocess.run(worker_command(args, world), env=env, stdout=log, stderr=subprocess.STDOUT)
+        subprocess.run(worker_command(args, world, closed), env=env, stdout=log, stderr=subprocess.STDOUT)
     try:
         with open(os.path.join(out_dir, RESULT_NAME)) as result_file:
             return json.load(result_file)

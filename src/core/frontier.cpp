@@ -1,0 +1,109 @@
+#include "hidden_rooms/frontier.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <opencv2/imgproc.hpp>
+
+namespace hidden_rooms {
+
+FrontierMap findFrontiers(const OccupancyGrid& map, const FrontierOptions& options) {
+  FrontierMap result;
+  if (map.empty()) return result;
+  const int rows = map.height(), cols = map.width();
+  result.labels = cv::Mat1i::zeros(rows, cols);
+
+  // Unknown areas big enough to be worth exploring (4-connected, as the frontier test below looks at them).
+  // Uncertain cells (seen too rarely to be free or occupied) are as good as unknown.
+  const cv::Mat1b unknown = (map.cells < 0) | ((map.cells > options.free_threshold) & (map.cells < options.occupied_threshold));
+  cv::Mat1i unknown_labels, unknown_stats;
+  cv::Mat centroids;
+  cv::connectedComponentsWithStats(unknown, unknown_labels, unknown_stats, centroids, 4, CV_32S);
+  const auto significant_unknown = [&](int col, int row) {
+    if (col < 0 || row < 0 || col >= cols || row >= rows) return true;  // beyond the grid nothing is known
+    const int label = unknown_labels(row, col);
+    return label > 0 && unknown_stats(label, cv::CC_STAT_AREA) >= options.min_unknown_cells;
+  };
+
+  cv::Mat1b frontier_cells = cv::Mat1b::zeros(rows, cols);
+  for (int row = 0; row < rows; ++row)
+    for (int col = 0; col < cols; ++col) {
+      const int value = map.cells(row, col);
+      if (value < 0 || value > options.free_threshold) continue;
+      if (significant_unknown(col + 1, row) || significant_unknown(col - 1, row) ||
+          significant_unknown(col, row + 1) || significant_unknown(col, row - 1))
+        frontier_cells(row, col) = 255;
+    }
+
+  cv::Mat1i groups, stats;
+  const int group_count = cv::connectedComponentsWithStats(frontier_cells, groups, stats, centroids, 8, CV_32S);
+  std::vector<int> kept;
+  for (int label = 1; label < group_count; ++label)
+    if (stats(label, cv::CC_STAT_AREA) >= options.min_frontier_cells) kept.push_back(label);
+  std::stable_sort(kept.begin(), kept.end(), [&](int a, int b) {
+    return stats(a, cv::CC_STAT_AREA) > stats(b, cv::CC_STAT_AREA);
+  });
+  std::vector<int> new_label(group_count, 0);
+  for (size_t i = 0; i < kept.size(); ++i) new_label[kept[i]] = static_cast<int>(i) + 1;
+
+  result.frontiers.resize(kept.size());
+  for (size_t i = 0; i < kept.size(); ++i) result.frontiers[i].label = static_cast<int>(i) + 1;
+  for (int row = 0; row < rows; ++row)
+    for (int col = 0; col < cols; ++col) {
+      const int label = new_label[groups(row, col)];
+      if (label == 0) continue;
+      result.labels(row, col) = label;
+      Frontier& frontier = result.frontiers[label - 1];
+      frontier.cells.emplace_back(col, row);
+      frontier.centroid += map.cellCentre(col, row);
+    }
+  for (Frontier& frontier : result.frontiers) frontier.centroid /= static_cast<double>(frontier.cells.size());
+  return result;
+}
+
+bool Blacklist::contains(const Point2& point) const {
+  return std::any_of(points.begin(), points.end(),
+                     [&](const Point2& listed) { return (listed - point).norm() <= radius; });
+}
+
+std::optional<FrontierGoal> nearestFrontierGoal(const FrontierMap& frontiers, const GridPlanner& planner,
+                                                const Blacklist& blacklist, const FrontierOptions& options,
+                                                const std::optional<Point2>& previous, double hysteresis) {
+  const OccupancyGrid& map = planner.map();
+  if (map.empty() || frontiers.frontiers.empty() || planner.startCell().x < 0) return std::nullopt;
+  const int reach = static_cast<int>(std::floor(options.goal_reach / map.resolution));
+  const cv::Mat1b& traversable = planner.traversable();
+
+  const Point2 robot = map.cellCentre(planner.startCell().x, planner.startCell().y);
+  const auto acceptable = [&](const Point2& position) {
+    return (position - robot).norm() >= options.min_goal_distance && !blacklist.contains(position);
+  };
+  // Per cell, the frontier that claims it (the first one found within reach); cells are visited once.
+  cv::Mat1i claimed = cv::Mat1i::zeros(map.height(), map.width());
+  std::optional<FrontierGoal> best;
+  for (const Frontier& frontier : frontiers.frontiers) {
+    for (const cv::Point& cell : frontier.cells) {
+      for (int row = std::max(0, cell.y - reach); row <= std::min(map.height() - 1, cell.y + reach); ++row)
+        for (int col = std::max(0, cell.x - reach); col <= std::min(map.width() - 1, cell.x + reach); ++col) {
+          if (claimed(row, col) != 0 || traversable(row, col) == 0) continue;
+          if ((col - cell.x) * (col - cell.x) + (row - cell.y) * (row - cell.y) > reach * reach) continue;
+          claimed(row, col) = frontier.label;
+          const double cost = planner.costTo(col, row);
+          if (!std::isfinite(cost) || (best && cost >= best->cost)) continue;
+          const Point2 position = map.cellCentre(col, row);
+          if (!acceptable(position)) continue;
+          best = FrontierGoal{frontier.label, {col, row}, position, cost};
+        }
+    }
+  }
+  if (!best || !previous) return best;
+
+  // Keep the previous goal while a frontier still claims it and it is not much dearer than the best.
+  int col = 0, row = 0;
+  if (!map.cellOf(*previous, &col, &row) || claimed(row, col) == 0 || blacklist.contains(*previous)) return best;
+  const double cost = planner.costTo(col, row);
+  if (!std::isfinite(cost) || cost > best->cost + hysteresis) return best;
+  return FrontierGoal{claimed(row, col), {col, row}, map.cellCentre(col, row), cost};
+}
+
+}  // namespace hidden_rooms

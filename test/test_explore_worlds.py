@@ -1,0 +1,83 @@
+#!/usr/bin/python3
+"""scripts/explore_worlds end to end on test/simulator_corridor.xml (a corridor with two rooms) with door 1
+closed: its own ROS master, simulator + mapper + explorer + pose_logger until the explorer is done, then the
+saved map, the door translated into the map frame, the true room, the prediction and the summary; and bad input.
+
+Needs the built package (found like the scripts find it: $CMAKE_PREFIX_PATH, else the checkout's .ws) and
+roslaunch; skips without them, unless HIDDEN_ROOMS_REQUIRE_SHARED=1 (scripts/test.sh), when it fails.
+"""
+import csv
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import unittest
+
+import yaml
+
+PACKAGE_DIR = os.path.dirname(os.path.dirname(os.path.realpath(__file__)))
+sys.path.insert(0, os.path.join(PACKAGE_DIR, "src"))
+from hidden_rooms import package_tools  # noqa: E402
+
+SCRIPT = os.path.join(PACKAGE_DIR, "scripts", "explore_worlds")
+WORLD = os.path.join(PACKAGE_DIR, "test", "simulator_corridor.xml")
+
+
+def run(*arguments, timeout=600):
+    return subprocess.run([sys.executable, SCRIPT] + list(arguments), capture_output=True, text=True, timeout=timeout)
+
+
+class ExploreWorldsTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        try:
+            package_tools.find_binary("translate_doors")
+            package_tools.find_binary("explorer")
+        except package_tools.ToolError as error:
+            if os.environ.get("HIDDEN_ROOMS_REQUIRE_SHARED") == "1":
+                raise AssertionError("package not built: %s" % error)
+            raise unittest.SkipTest(str(error))
+        cls.out = tempfile.mkdtemp(prefix="hidden_rooms_explore_worlds_")
+        # A map saved every 25 s of simulated time; the run ends when the explorer is done or a map did not grow.
+        cls.result = run(WORLD, "--out", cls.out, "--closed", "1", "--timeout", "25", "--growth", "0",
+                         "--max-time", "300")
+
+    @classmethod
+    def tearDownClass(cls):
+        shutil.rmtree(cls.out, ignore_errors=True)
+
+    def test_explores_to_completion_and_predicts_the_hidden_room(self):
+        self.assertEqual(self.result.returncode, 0, self.result.stdout + self.result.stderr)
+        with open(os.path.join(self.out, "summary.csv")) as summary_file:
+            rows = list(csv.DictReader(summary_file))
+        self.assertEqual(len(rows), 1)
+        row = rows[0]
+        self.assertIn(row["status"], ("done", "no_growth"), row)
+        self.assertGreaterEqual(float(row["coverage"]), 0.95, row)
+        self.assertLess(float(row["worst_door_error_m"]), 0.3, row)
+        self.assertGreater(float(row["mean_iou"]), 0.7, row)
+        self.assertGreater(float(row["path_length_m"]), 5.0, row)
+        run_dir = os.path.join(self.out, "simulator_corridor")
+        for name in ("map.yaml", "map.pgm", "doors.yaml", "true_rooms.png", "exploration.yaml", "overlay.png",
+                     "poses_map.log", "poses_truth.log", "prediction/map.yaml", "prediction/metrics.yaml"):
+            self.assertTrue(os.path.isfile(os.path.join(run_dir, name)), name)
+        self.assertTrue(os.listdir(os.path.join(run_dir, "maps")), "no map saved at the timeouts")
+        with open(os.path.join(run_dir, "doors.yaml")) as doors_file:
+            doors = yaml.safe_load(doors_file)["doors"]
+        self.assertEqual([door["id"] for door in doors], [1])
+
+    def test_bad_input_exits_2_with_a_message(self):
+        missing = run(os.path.join(self.out, "no_such_world.xml"), "--out", self.out)
+        self.assertEqual(missing.returncode, 2)
+        self.assertIn("no_such_world.xml", missing.stderr)
+        jobs = run(WORLD, "--out", self.out, "--jobs", "0")
+        self.assertEqual(jobs.returncode, 2)
+        self.assertIn("--jobs", jobs.stderr)
+        bad_random = run(WORLD, "--out", os.path.join(self.out, "bad"), "--closed", "random:x")
+        self.assertEqual(bad_random.returncode, 2)
+        self.assertIn("random:N", bad_random.stderr)
+
+
+if __name__ == "__main__":
+    unittest.main()

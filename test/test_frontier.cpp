@@ -1,0 +1,142 @@
+// Frontier extraction (groups, small ones and unknown specks dropped) and the nearest-frontier goal by path cost.
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "hidden_rooms/frontier.h"
+#include "hidden_rooms/grid_planner.h"
+
+namespace hidden_rooms {
+namespace {
+
+// 0.1 m cells, origin (0, 0); the whole grid unknown.
+OccupancyGrid unknownGrid(int cols, int rows) {
+  OccupancyGrid grid;
+  grid.resolution = 0.1;
+  grid.cells = cv::Mat_<int8_t>(rows, cols, OccupancyGrid::kUnknown);
+  return grid;
+}
+
+TEST(Frontier, EmptyMapHasNone) {
+  const FrontierMap frontiers = findFrontiers(OccupancyGrid());
+  EXPECT_TRUE(frontiers.frontiers.empty());
+}
+
+TEST(Frontier, FullyKnownRoomHasNone) {
+  OccupancyGrid grid = unknownGrid(30, 20);
+  grid.cells.setTo(OccupancyGrid::kOccupied);
+  grid.cells(cv::Rect(1, 1, 28, 18)).setTo(OccupancyGrid::kFree);
+  EXPECT_TRUE(findFrontiers(grid).frontiers.empty());
+}
+
+TEST(Frontier, GroupsTwoOpeningsAndDropsSmallOnes) {
+  // A walled free room (cols 5..24, rows 5..14) in unknown space with two gaps in its walls: 6 cells on the left
+  // wall and 2 cells on the right wall, which is below min_frontier_cells.
+  OccupancyGrid grid = unknownGrid(40, 20);
+  grid.cells(cv::Rect(4, 4, 22, 12)).setTo(OccupancyGrid::kOccupied);
+  grid.cells(cv::Rect(5, 5, 20, 10)).setTo(OccupancyGrid::kFree);
+  grid.cells(cv::Rect(4, 7, 1, 6)).setTo(OccupancyGrid::kFree);   // left gap: rows 7..12
+  grid.cells(cv::Rect(25, 9, 1, 2)).setTo(OccupancyGrid::kFree);  // right gap: rows 9..10
+  FrontierOptions options;
+  options.min_frontier_cells = 4;
+  const FrontierMap frontiers = findFrontiers(grid, options);
+  ASSERT_EQ(frontiers.frontiers.size(), 1u);
+  const Frontier& left = frontiers.frontiers[0];
+  EXPECT_EQ(left.label, 1);
+  EXPECT_EQ(left.cells.size(), 6u);  // the gap cells touch unknown on their left
+  EXPECT_NEAR(left.centroid.x(), 0.45, 1e-9);
+  EXPECT_NEAR(left.centroid.y(), 1.0, 1e-9);  // rows 7..12 of 20 -> y from 1.25 down to 0.75
+  for (const cv::Point& cell : left.cells) EXPECT_EQ(frontiers.labels(cell.y, cell.x), 1);
+  EXPECT_EQ(frontiers.labels(10, 25), 0);
+
+  options.min_frontier_cells = 2;
+  const FrontierMap with_small = findFrontiers(grid, options);
+  ASSERT_EQ(with_small.frontiers.size(), 2u);
+  EXPECT_EQ(with_small.frontiers[0].cells.size(), 6u);  // largest first
+  EXPECT_EQ(with_small.frontiers[1].cells.size(), 2u);
+}
+
+TEST(Frontier, IgnoresUnknownSpecksAndCountsTheGridEdgeAsUnknown) {
+  OccupancyGrid grid = unknownGrid(30, 20);
+  grid.cells.setTo(OccupancyGrid::kFree);
+  grid.cells(cv::Rect(10, 10, 2, 2)).setTo(OccupancyGrid::kUnknown);  // a 4-cell speck
+  FrontierOptions options;
+  options.min_unknown_cells = 5;
+  options.min_frontier_cells = 1;
+  const FrontierMap frontiers = findFrontiers(grid, options);
+  // Only the free border (beyond which nothing is known): one ring of 2 * 30 + 2 * 18 cells.
+  ASSERT_EQ(frontiers.frontiers.size(), 1u);
+  EXPECT_EQ(frontiers.frontiers[0].cells.size(), 96u);
+  EXPECT_EQ(frontiers.labels(9, 10), 0);
+
+  options.min_unknown_cells = 4;
+  EXPECT_EQ(findFrontiers(grid, options).frontiers.size(), 2u);  // now the speck's 8-cell ring counts
+}
+
+TEST(Frontier, UncertainCellsCountAsUnknown) {
+  // A free room whose right part (cols 20..29) was seen too rarely to be free or occupied (value 40).
+  OccupancyGrid grid = unknownGrid(30, 20);
+  grid.cells.setTo(OccupancyGrid::kOccupied);
+  grid.cells(cv::Rect(1, 1, 28, 18)).setTo(OccupancyGrid::kFree);
+  grid.cells(cv::Rect(20, 1, 9, 18)).setTo(40);
+  const FrontierMap frontiers = findFrontiers(grid);
+  ASSERT_EQ(frontiers.frontiers.size(), 1u);
+  EXPECT_EQ(frontiers.frontiers[0].cells.size(), 18u);  // column 19
+  for (const cv::Point& cell : frontiers.frontiers[0].cells) EXPECT_EQ(cell.x, 19);
+}
+
+// A 10 m x 4 m free corridor (0.1 m cells) closed by walls, with unknown strips at both ends behind gaps:
+// frontier at the left end (x ~ 0.2) and at the right end (x ~ 9.8).
+OccupancyGrid corridorWithTwoEnds() {
+  OccupancyGrid grid = unknownGrid(100, 40);
+  grid.cells(cv::Rect(2, 0, 96, 40)).setTo(OccupancyGrid::kOccupied);
+  grid.cells(cv::Rect(2, 1, 96, 38)).setTo(OccupancyGrid::kFree);
+  return grid;
+}
+
+TEST(Frontier, NearestGoalIsTheCheaperEndAndSkipsTheBlacklist) {
+  const OccupancyGrid grid = corridorWithTwoEnds();
+  GridPlanner planner;
+  planner.setMap(grid);
+  ASSERT_TRUE(planner.computeCostsFrom(Point2(7.0, 2.0)));
+  const FrontierMap frontiers = findFrontiers(grid);
+  ASSERT_EQ(frontiers.frontiers.size(), 2u);
+  FrontierOptions options;
+  const std::optional<FrontierGoal> goal = nearestFrontierGoal(frontiers, planner, Blacklist(), options);
+  ASSERT_TRUE(goal.has_value());
+  EXPECT_GT(goal->position.x(), 9.0);   // the right end is 3 m away, the left one 7 m
+  EXPECT_LE(std::abs(goal->position.x() - 9.75), options.goal_reach + 1e-6);  // frontier cells at x = 9.75
+  EXPECT_NEAR(goal->cost, planner.costTo(goal->cell.x, goal->cell.y), 1e-12);
+  EXPECT_LT(goal->cost, 4.0);
+
+  Blacklist blacklist;
+  blacklist.radius = 3.0;
+  blacklist.points.push_back(Point2(9.8, 2.0));
+  const std::optional<FrontierGoal> other = nearestFrontierGoal(frontiers, planner, blacklist, options);
+  ASSERT_TRUE(other.has_value());
+  EXPECT_LT(other->position.x(), 1.0);
+  EXPECT_GT(other->cost, 5.5);
+
+  // Hysteresis: a previous goal at the left end is kept only while it costs at most `hysteresis` more.
+  EXPECT_GT(nearestFrontierGoal(frontiers, planner, Blacklist(), options, other->position, 1.0)->position.x(), 9.0);
+  EXPECT_LT(nearestFrontierGoal(frontiers, planner, Blacklist(), options, other->position, 100.0)->position.x(), 1.0);
+}
+
+TEST(Frontier, UnreachableFrontierGivesNoGoal) {
+  // A frontier in a second room that a wall separates from the robot's.
+  OccupancyGrid grid = corridorWithTwoEnds();
+  grid.cells(cv::Rect(50, 0, 2, 40)).setTo(OccupancyGrid::kOccupied);  // wall across at x = 5.0..5.2
+  grid.cells(cv::Rect(0, 0, 2, 40)).setTo(OccupancyGrid::kOccupied);   // left end closed: only the right frontier
+  GridPlanner planner;
+  planner.setMap(grid);
+  ASSERT_TRUE(planner.computeCostsFrom(Point2(2.0, 2.0)));
+  const FrontierMap frontiers = findFrontiers(grid);
+  ASSERT_EQ(frontiers.frontiers.size(), 1u);
+  EXPECT_FALSE(nearestFrontierGoal(frontiers, planner, Blacklist(), FrontierOptions()).has_value());
+  // From the other side it is reachable.
+  ASSERT_TRUE(planner.computeCostsFrom(Point2(8.0, 2.0)));
+  EXPECT_TRUE(nearestFrontierGoal(frontiers, planner, Blacklist(), FrontierOptions()).has_value());
+}
+
+}  // namespace
+}  // namespace hidden_rooms
