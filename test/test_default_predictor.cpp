@@ -182,12 +182,69 @@ TEST(DefaultPredictor, WallStubsEndTheRoomsAlongTheirWall) {
   EXPECT_LT(scoreOf(s, makeRoomPredictor("default")->predict(s.request)).iou[0], 0.8);
 }
 
+// A map drawn from a state image (0 unknown, 1 free, 2 wall) with doors on horizontal walls (image column, row).
+Synthetic syntheticFromStates(const cv::Mat1b& states, const cv::Mat1w& truth,
+                              const std::vector<cv::Point2d>& doors) {
+  Synthetic result;
+  result.truth = truth;
+  OccupancyGrid& map = result.request.map;
+  map.resolution = 0.05;
+  map.cells = cv::Mat_<int8_t>(states.size(), OccupancyGrid::kUnknown);
+  map.cells.setTo(OccupancyGrid::kFree, states == 1);
+  map.cells.setTo(OccupancyGrid::kOccupied, states == 2);
+  for (size_t k = 0; k < doors.size(); ++k) {
+    MapDoor door;
+    door.id = static_cast<int>(k + 1);
+    door.width = 1.0;
+    door.orientation = DoorOrientation::kAlongX;
+    door.position = Point2(doors[k].x * map.resolution, (states.rows - doors[k].y) * map.resolution);
+    result.request.doors.doors.push_back(door);
+  }
+  return result;
+}
+
+// A hidden room above a corridor whose door sits at the back of a shallow niche: the niche's side walls run
+// from the door's line to the corridor's wall, which is not a pillar standing free; the room spans the wall.
+TEST(DefaultPredictor, NicheSideWallsAreNotStubs) {
+  const cv::Size size(240, 160);
+  cv::Mat1b states(size, 0);
+  states(cv::Rect(17, 95, 206, 48)).setTo(2);   // around the corridor
+  states(cv::Rect(20, 99, 200, 40)).setTo(1);   // corridor
+  states(cv::Rect(17, 2, 206, 18)).setTo(2);    // around a service corridor above the room
+  states(cv::Rect(20, 5, 200, 12)).setTo(1);
+  states(cv::Rect(97, 89, 26, 10)).setTo(2);    // the niche's walls and the door's line
+  states(cv::Rect(100, 92, 20, 7)).setTo(1);    // the niche
+  cv::Mat1w truth = cv::Mat1w::zeros(size);
+  truth(cv::Rect(20, 20, 200, 75)).setTo(1);
+  truth.setTo(0, states != 0);
+  Synthetic s = syntheticFromStates(states, truth, {{110, 90}});
+  s.request.parameters["default_grown_area_ratio"] = 1000.0;  // the wall-fitted rectangle only
+  EXPECT_GT(scoreOf(s, makeRoomPredictor("default")->predict(s.request)).iou[0], 0.9);
+}
+
+TEST(DefaultPredictor, ClipsRoomsToTheKnownOutlineBesideThem) {
+  cv::Mat1b known = cv::Mat1b::zeros(100, 100);
+  known(cv::Rect(60, 20, 30, 60)).setTo(255);  // an explored room beside the hidden one, rows 20..79
+  known(cv::Rect(0, 80, 100, 10)).setTo(255);  // the corridor below both
+  cv::Mat1b room = cv::Mat1b::zeros(100, 100);
+  room(cv::Rect(10, 0, 40, 80)).setTo(255);    // a hidden room predicted up to the image's edge
+  clipToKnownOutline(known, cv::Point(30, 80), 20, 10, &room);
+  EXPECT_EQ(cv::boundingRect(room), cv::Rect(10, 20, 40, 60));
+  // Nothing known beyond the door on that side: no limit.
+  cv::Mat1b alone = cv::Mat1b::zeros(100, 100);
+  alone(cv::Rect(10, 0, 40, 80)).setTo(255);
+  cv::Mat1b corridor_only = cv::Mat1b::zeros(100, 100);
+  corridor_only(cv::Rect(0, 80, 100, 10)).setTo(255);
+  clipToKnownOutline(corridor_only, cv::Point(30, 80), 20, 10, &alone);
+  EXPECT_EQ(cv::boundingRect(alone), cv::Rect(10, 0, 40, 80));
+}
+
 // Mean IoU of `default` over the benchmark's 44 valid cases; the floor sits a little under the measured mean
-// (0.645), so that a regression fails.
+// (0.670), so that a regression fails.
 TEST(DefaultPredictor, KeepsItsAccuracyOnTheBenchmark) {
   HIDDEN_ROOMS_REQUIRE_SHARED_DATA();
   int cases = 0;
-  EXPECT_GE(testing::benchmarkMeanIou("default", &cases), 0.64);
+  EXPECT_GE(testing::benchmarkMeanIou("default", &cases), 0.66);
   EXPECT_EQ(cases, 44);
 }
 

@@ -23,12 +23,18 @@
 //      side, else the room's width (a square, as the thesis does).
 // 3. The rectangle's unknown pixels connected to the door; pixels claimed by several rooms go to the nearest
 //    door.
+// Lateral extent and wall stubs: a stub ends the extent unless the wall goes on past it at another row (the side
+// wall of a door niche or of a step in the wall: no free space beyond it and wall pixels within its length).
+//
+// Every room, grown or rectangle (not on turned maps), is then clipped to the known map's outline beside it
+// (clipToKnownOutline, default_outline_reach): a room does not stick out of the building past the outer walls
+// its neighbours show; a side where nothing is known beyond the door is left open.
 //
 // Parameters: start_search_radius and the default_* keys (config/prediction.yaml), and the layout's
 // (config/layout.yaml) for the grown rooms; --debug-dir receives the layout's images.
 // terms: "rectangle" (1 when the rectangle was chosen, 0 the grown room); a grown room has the thesis's terms, a
 // rectangle "width", "depth" (metres), "depth_bounded" (1 when the depth came from the map, 0 from a prior) and
-// "rotation" (degrees the map was turned).
+// "rotation" (degrees the map was turned); every room "outline_clipped" (m^2 removed by the outline clip).
 
 #include <map>
 #include <string>
@@ -48,5 +54,11 @@ class DefaultPredictor : public RoomPredictor {
 // Dominant wall direction of a map, radians in [-pi/4, pi/4): the walls run along this angle and the one
 // perpendicular to it (image frame: x = column, y = row). 0 when the map has no occupied cells.
 double dominantWallAngle(const OccupancyGrid& map);
+
+// Clips a room (mask, image frame) to the known map's extent beside it: x to the known pixels of the rows within
+// `reach` pixels of the room's rows, y likewise from its columns, so that a room does not stick out of the
+// building past the outer walls its neighbours show. A limit is applied only when it lies at least `min_depth`
+// pixels beyond the door pixel (otherwise nothing is known on that side).
+void clipToKnownOutline(const cv::Mat1b& known, const cv::Point& door, int reach, int min_depth, cv::Mat1b* mask);
 
 }  // namespace hidden_rooms

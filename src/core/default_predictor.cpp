@@ -25,6 +25,7 @@ constexpr double kMinDepth = 2.0;            // m: smallest depth taken from the
 constexpr double kMinRotation = 1.0;         // degrees: smaller dominant angles are not corrected
 constexpr double kGrownAreaRatio = 0.6;      // grown rooms smaller than this share of the rectangle give way
 constexpr double kStubLength = 0.3;          // m: wall stubs this long into the explored side end a room's extent
+constexpr double kOutlineReach = 15.0;       // m: band beside a room within which the known map's extent bounds it
 
 // Working states of a pixel.
 constexpr uint8_t kUnknownPx = 0, kFreePx = 1, kOccupiedPx = 2;
@@ -42,7 +43,7 @@ cv::Mat1b statesOf(const OccupancyGrid& map) {
 
 struct Parameters {
   double start_search_radius, wall_gap, max_extent, bounded_fraction, neighbour_reach, min_depth, min_rotation;
-  double grown_area_ratio, stub_length;
+  double grown_area_ratio, stub_length, outline_reach;
 };
 
 // A door in the working image: centre pixel, wall axis a and normal n (unit axis vectors, n into the unknown).
@@ -143,6 +144,19 @@ int occupiedRun(const Frame& f, const DoorFrame& d, int u, int v, int limit) {
   return run;
 }
 
+// Whether the wall goes on past a stub at a stepped row, as past the side wall of a door niche: beyond the stub
+// (column u_after onwards, `step` = +-1) row v_mid is not free and, within two columns, an occupied pixel lies
+// between rows v_from and v_to (the stub's length). A free-standing stub (a pillar, the end of a perpendicular
+// wall) has free space beyond it; a corner of the wall has nothing beyond it.
+bool isWallStep(const Frame& f, const DoorFrame& d, int u_after, int step, int v_from, int v_to, int v_mid) {
+  for (int k = 0; k < 3; ++k)
+    if (f.state(f.at(d, u_after + k * step, v_mid)) == kFreePx) return false;
+  for (int k = 0; k < 3; ++k)
+    for (int v = std::min(v_from, v_to); v <= std::max(v_from, v_to); ++v)
+      if (f.state(f.at(d, u_after + k * step, v)) == kOccupiedPx) return true;
+  return false;
+}
+
 // How far the room reaches along the wall in direction `sign`.
 int lateralExtent(const Frame& f, double resolution, const Parameters& P, DoorFrame* d, int sign) {
   const int max_u = static_cast<int>(P.max_extent / resolution);
@@ -177,7 +191,9 @@ int lateralExtent(const Frame& f, double resolution, const Parameters& P, DoorFr
       int width = 1;
       while (width < max_stub_width && occupiedRun(f, *d, sign * (k + width), band0 - 1, stub_px) >= stub_px)
         ++width;
-      return sign * (k + (width - 1) / 2 - 1);  // up to the stub's middle column, exclusive
+      // The side wall of a door niche (or of a step in the wall) is no stub: the wall goes on past it.
+      if (!isWallStep(f, *d, sign * (k + width), sign, band0 - 1, band0 - stub_px, band0 - 1 - stub_px / 2))
+        return sign * (k + (width - 1) / 2 - 1);  // up to the stub's middle column, exclusive
     }
     int first = std::numeric_limits<int>::max(), last = std::numeric_limits<int>::min();
     for (int v = band0 - 2; v <= band1 + 2; ++v)
@@ -253,12 +269,36 @@ double neighbourDepth(const Frame& f, double resolution, const Parameters& P, co
   return depth * resolution >= P.min_depth ? depth : -1.0;
 }
 
+// The image pixel of a door's position.
+cv::Point doorPixel(const OccupancyGrid& map, const MapDoor& door) {
+  const Point2 image = map.toImage(door.position);
+  return {static_cast<int>(std::floor(image.x())), static_cast<int>(std::floor(image.y()))};
+}
+
 // Rotation of a point about the working transform.
 cv::Point2d applyAffine(const cv::Matx23d& m, const cv::Point2d& p) {
   return {m(0, 0) * p.x + m(0, 1) * p.y + m(0, 2), m(1, 0) * p.x + m(1, 1) * p.y + m(1, 2)};
 }
 
 }  // namespace
+
+void clipToKnownOutline(const cv::Mat1b& known, const cv::Point& door, int reach, int min_depth, cv::Mat1b* mask) {
+  const cv::Rect image(0, 0, known.cols, known.rows);
+  const cv::Rect room = cv::boundingRect(*mask);
+  if (room.area() == 0) return;
+  // x limits from the rows beside the room, y limits from its columns.
+  const cv::Rect rows = cv::Rect(0, room.y - reach, known.cols, room.height + 2 * reach) & image;
+  const cv::Rect columns = cv::Rect(room.x - reach, 0, room.width + 2 * reach, known.rows) & image;
+  const cv::Rect in_rows = cv::boundingRect(known(rows)), in_columns = cv::boundingRect(known(columns));
+  if (in_rows.area() == 0 || in_columns.area() == 0) return;
+  const int x0 = in_rows.x, x1 = in_rows.br().x, y0 = in_columns.y + columns.y, y1 = in_columns.br().y + columns.y;
+  // Keep [x0, x1) x [y0, y1), each limit only when it lies at least min_depth beyond the door.
+  const cv::Rect keep(cv::Point(door.x - x0 >= min_depth ? x0 : 0, door.y - y0 >= min_depth ? y0 : 0),
+                      cv::Point(x1 - door.x >= min_depth ? x1 : known.cols, y1 - door.y >= min_depth ? y1 : known.rows));
+  cv::Mat1b outside(mask->size(), 255);
+  outside(keep & image).setTo(0);
+  mask->setTo(0, outside);
+}
 
 double dominantWallAngle(const OccupancyGrid& map) {
   cv::Mat1f occupied(map.cells.size(), 0.0f);
@@ -307,7 +347,7 @@ std::map<std::string, double> DefaultPredictor::defaultParameters() const {
                      {"default_max_extent", kMaxExtent},          {"default_bounded_fraction", kBoundedFraction},
                      {"default_neighbour_reach", kNeighbourReach}, {"default_min_depth", kMinDepth},
                      {"default_min_rotation", kMinRotation},       {"default_grown_area_ratio", kGrownAreaRatio},
-                     {"default_stub_length", kStubLength}});
+                     {"default_stub_length", kStubLength},         {"default_outline_reach", kOutlineReach}});
   return parameters;
 }
 
@@ -533,10 +573,10 @@ PredictionResult DefaultPredictor::predict(const PredictionRequest& request) con
                      values.at("default_max_extent"),      values.at("default_bounded_fraction"),
                      values.at("default_neighbour_reach"), values.at("default_min_depth"),
                      values.at("default_min_rotation"),    values.at("default_grown_area_ratio"),
-                     values.at("default_stub_length")};
+                     values.at("default_stub_length"),     values.at("default_outline_reach")};
   if (P.start_search_radius <= 0.0 || P.wall_gap < 0.0 || P.max_extent <= 0.0 || P.neighbour_reach < 0.0 ||
       P.min_depth < 0.0 || P.min_rotation < 0.0 || P.bounded_fraction < 0.0 || P.bounded_fraction > 1.0 ||
-      P.grown_area_ratio < 0.0 || P.stub_length < 0.0)
+      P.grown_area_ratio < 0.0 || P.stub_length < 0.0 || P.outline_reach < 0.0)
     throw InputError("parameters", "default_* parameters out of range");
 
   const double angle = dominantWallAngle(request.map);
@@ -561,11 +601,21 @@ PredictionResult DefaultPredictor::predict(const PredictionRequest& request) con
     use_rectangle[i] = turned || (rectangles[i].placed && grown[i].area < P.grown_area_ratio * rectangles[i].area);
     if (!use_rectangle[i] && grown[i].placed) kept_grown |= grown[i].mask;
   }
+  const cv::Mat1b known = request.map.cells != OccupancyGrid::kUnknown;
+  const double resolution = request.map.resolution;
   PredictionResult result;
   for (size_t i = 0; i < count; ++i) {
     RoomPrediction room = std::move(use_rectangle[i] ? rectangles[i] : grown[i]);
     if (use_rectangle[i]) {
       room.mask.setTo(0, kept_grown);
+      finishPrediction(request.map, &room);
+    }
+    if (!turned && P.outline_reach > 0.0 && room.placed) {
+      const int before = cv::countNonZero(room.mask);
+      clipToKnownOutline(known, doorPixel(request.map, request.doors.doors[i]),
+                         static_cast<int>(std::lround(P.outline_reach / resolution)),
+                         static_cast<int>(std::lround(P.min_depth / resolution)), &room.mask);
+      room.terms["outline_clipped"] = (before - cv::countNonZero(room.mask)) * resolution * resolution;
       finishPrediction(request.map, &room);
     }
     room.terms["rectangle"] = use_rectangle[i] ? 1.0 : 0.0;
