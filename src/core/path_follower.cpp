@@ -101,24 +101,29 @@ std::vector<Point2> ObstacleMemory::points(const Pose2& pose) const {
   return result;
 }
 
-double frontClearance(const std::vector<Point2>& obstacles, const PathFollowerOptions& options) {
+namespace {
+
+// Free distance beyond the footprint's front (`direction` +1) or rear (-1) within its lane.
+double laneClearance(const std::vector<Point2>& obstacles, const PathFollowerOptions& options, double direction) {
   const double half_length = 0.5 * options.footprint_length;
   const double half_lane = 0.5 * options.footprint_width + options.side_margin;
   double clearance = kInfinity;
-  for (const Point2& point : obstacles)
-    if (point.allFinite() && std::abs(point.y()) <= half_lane && point.x() >= 0.0)
-      clearance = std::min(clearance, std::max(0.0, point.x() - half_length));
+  for (const Point2& point : obstacles) {
+    const double along = direction * point.x();
+    if (point.allFinite() && std::abs(point.y()) <= half_lane && (along > 0.0 || (along == 0.0 && direction > 0)))
+      clearance = std::min(clearance, std::max(0.0, along - half_length));
+  }
   return clearance;
 }
 
+}  // namespace
+
+double frontClearance(const std::vector<Point2>& obstacles, const PathFollowerOptions& options) {
+  return laneClearance(obstacles, options, 1.0);
+}
+
 double rearClearance(const std::vector<Point2>& obstacles, const PathFollowerOptions& options) {
-  const double half_length = 0.5 * options.footprint_length;
-  const double half_lane = 0.5 * options.footprint_width + options.side_margin;
-  double clearance = kInfinity;
-  for (const Point2& point : obstacles)
-    if (point.allFinite() && std::abs(point.y()) <= half_lane && point.x() < 0.0)
-      clearance = std::min(clearance, std::max(0.0, -point.x() - half_length));
-  return clearance;
+  return laneClearance(obstacles, options, -1.0);
 }
 
 PathFollower::PathFollower(const PathFollowerOptions& options) : options_(options) { validate(options_); }
