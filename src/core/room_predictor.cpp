@@ -49,7 +49,8 @@ std::map<std::string, double> loadParameterFile(const std::string& path) {
   if (root.IsNull()) return parameters;
   if (!root.IsMap()) throw InputError(path, "parameters file must be a mapping of names to numbers");
   for (const auto& entry : root) {
-    const std::string name = entry.first.as<std::string>();
+    if (!entry.first.IsScalar()) throw InputError(path, "a parameter name is not a plain name");
+    const std::string name = entry.first.Scalar();
     double value = 0.0;
     try {
       value = entry.second.as<double>();
