@@ -114,6 +114,27 @@ TEST(DoorTranslation, FitsTheWorldFromMapTransform) {
   EXPECT_THROW(fitWorldFromMap(truth, {{100.0, {0.0, 0.0, 0.0}}}), InputError);
 }
 
+TEST(DoorTranslation, FitsNearAPlaceWhereTheMapIsBent) {
+  // The first half of the run mapped with one transform, the second half (x > 10) with another: the map is bent.
+  const Pose2 first{1.0, 2.0, 0.0}, second{1.3, 2.1, 0.05};
+  std::vector<TimedPose> truth, estimate;
+  for (int k = 0; k <= 400; ++k) {
+    const double t = 0.1 * k;
+    const Pose2 world{0.5 * t, 0.2 * std::sin(0.3 * t), 0.0};
+    truth.push_back({t, world});
+    estimate.push_back({t, composePoses(invertPose(world.x <= 10.0 ? first : second), world)});
+  }
+  const Pose2 near_end = fitWorldFromMapNear(truth, estimate, Point2(18.0, 0.0), 5.0);
+  EXPECT_NEAR(near_end.x, second.x, 1e-6);
+  EXPECT_NEAR(near_end.yaw, second.yaw, 1e-6);
+  const Pose2 near_start = fitWorldFromMapNear(truth, estimate, Point2(2.0, 0.0), 5.0);
+  EXPECT_NEAR(near_start.y, first.y, 1e-6);
+  // Nobody near: the whole run.
+  const Pose2 nowhere = fitWorldFromMapNear(truth, estimate, Point2(100.0, 100.0), 5.0);
+  const Pose2 whole = fitWorldFromMap(truth, estimate);
+  EXPECT_DOUBLE_EQ(nowhere.x, whole.x);
+}
+
 TEST(DoorTranslation, ReachableFreeCellsStopAtWalls) {
   OccupancyGrid grid;
   grid.resolution = 0.1;

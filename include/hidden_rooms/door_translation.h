@@ -41,6 +41,12 @@ DoorsFile translateDoors(const Environment& environment, const std::vector<int>&
 // span any distance.
 Pose2 fitWorldFromMap(const std::vector<TimedPose>& truth, const std::vector<TimedPose>& estimate);
 
+// The same fit over the poses whose true position lies within `radius` of `centre` (world frame): where the map
+// shows a place, free of the drift a long run accumulates elsewhere. The whole run when too few poses (< 20) are
+// near.
+Pose2 fitWorldFromMapNear(const std::vector<TimedPose>& truth, const std::vector<TimedPose>& estimate,
+                          const Point2& centre, double radius);
+
 // The world's ground truth moved into the grid of `map`: `labels` (map's size) holds 1 + space index on the
 // free cells of each space (nearest cell of `rendered` after the transform), 0 elsewhere.
 cv::Mat1w spaceLabelsInMap(const RenderedEnvironment& rendered, const OccupancyGrid& map, const Pose2& world_from_map);

@@ -91,6 +91,22 @@ Pose2 fitWorldFromMap(const std::vector<TimedPose>& truth, const std::vector<Tim
   return {transform(0, 2), transform(1, 2), std::atan2(transform(1, 0), transform(0, 0))};
 }
 
+Pose2 fitWorldFromMapNear(const std::vector<TimedPose>& truth, const std::vector<TimedPose>& estimate,
+                          const Point2& centre, double radius) {
+  constexpr size_t kMinPoses = 20;
+  std::vector<TimedPose> near;
+  for (const TimedPose& entry : estimate) {
+    const Pose2 world = poseAt(truth, entry.time);
+    if ((Point2(world.x, world.y) - centre).norm() <= radius) near.push_back(entry);
+  }
+  if (near.size() < kMinPoses) return fitWorldFromMap(truth, estimate);
+  try {
+    return fitWorldFromMap(truth, near);
+  } catch (const InputError&) {  // the near poses span no distance
+    return fitWorldFromMap(truth, estimate);
+  }
+}
+
 cv::Mat1w spaceLabelsInMap(const RenderedEnvironment& rendered, const OccupancyGrid& map, const Pose2& world_from_map) {
   cv::Mat1w labels = cv::Mat1w::zeros(map.height(), map.width());
   for (int row = 0; row < map.height(); ++row) {
