@@ -97,5 +97,31 @@ TEST(MapQuality, TrajectoryErrorAfterTheTransform) {
   EXPECT_NEAR(identity.yaw, 0.0, 1e-12);
 }
 
+TEST(MapQuality, DrawsTheComparison) {
+  const OccupancyGrid truth = room(Point2(0.0, 0.0));
+  OccupancyGrid map = truth;
+  map.cells = truth.cells.clone();  // (cv::Mat copies share their cells)
+  map.cells(10, 10) = OccupancyGrid::kUnknown;  // missed, never observed
+  map.cells(10, 11) = 40;                        // missed, uncertain
+  map.cells(10, 12) = OccupancyGrid::kOccupied;  // missed, a wall in the map
+  map.cells(0, 5) = OccupancyGrid::kFree;        // free where the truth has a wall
+  const cv::Mat3b picture = drawMapComparison(map, Pose2{}, truth, cv::Mat1b());
+  ASSERT_EQ(picture.rows, truth.height());
+  ASSERT_EQ(picture.cols, truth.width());
+  EXPECT_EQ(picture(20, 20), cv::Vec3b(255, 255, 255));
+  EXPECT_EQ(picture(10, 10), cv::Vec3b(0, 165, 255));
+  EXPECT_EQ(picture(10, 11), cv::Vec3b(0, 0, 255));
+  EXPECT_EQ(picture(10, 12), cv::Vec3b(255, 0, 255));
+  EXPECT_EQ(picture(0, 5), cv::Vec3b(255, 0, 0));
+  EXPECT_EQ(picture(0, 6), cv::Vec3b(0, 0, 0));
+  // Outside the observed cells a true free cell is neither hit nor miss.
+  cv::Mat1b observed = cv::Mat1b::zeros(truth.height(), truth.width());
+  observed(cv::Rect(1, 1, 5, 5)).setTo(255);
+  const cv::Mat3b restricted = drawMapComparison(map, Pose2{}, truth, observed);
+  EXPECT_EQ(restricted(2, 2), cv::Vec3b(255, 255, 255));
+  EXPECT_EQ(restricted(10, 11), cv::Vec3b(160, 160, 160));
+  EXPECT_EQ(restricted(20, 20), cv::Vec3b(255, 0, 0));  // map free, truth free but not observed
+}
+
 }  // namespace
 }  // namespace hidden_rooms

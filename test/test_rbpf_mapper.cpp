@@ -154,6 +154,21 @@ TEST(RbpfMapper, RejectsBadIniFiles) {
   options.config_file = dir + "/nogrid.ini";
   std::ofstream(options.config_file) << text;
   EXPECT_THROW({ RbpfMapper mapper(options); }, InputError);
+
+  // A published map's certainty outside (0.5, 1).
+  text.replace(at, 23, "occupancyGrid_count = 1");
+  const std::string freeness = "maxFreenessUpdateCertainty  = 0.70";
+  const size_t freeness_at = text.find(freeness);
+  ASSERT_NE(freeness_at, std::string::npos);
+  text.replace(freeness_at, freeness.size(), "maxFreenessUpdateCertainty  = 1.5");
+  options.config_file = dir + "/published.ini";
+  std::ofstream(options.config_file) << text;
+  try {
+    RbpfMapper mapper(options);
+    ADD_FAILURE() << "certainty 1.5 accepted";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("PublishedMap"), std::string::npos) << error.what();
+  }
 }
 
 }  // namespace

@@ -33,6 +33,12 @@ struct MapQuality {
 MapQuality evaluateMap(const OccupancyGrid& map, const Pose2& world_from_map, const OccupancyGrid& truth,
                        const cv::Mat1b& observed);
 
+// The comparison of evaluateMap as a picture on truth's grid (BGR): true walls black, true free cells that were
+// observed and mapped free white; observed true free cells the map misses: orange where it is unknown, red where
+// it is uncertain (between free and occupied), magenta where it has a wall; map-free cells where the truth is not observed-free blue, other cells grey.
+cv::Mat3b drawMapComparison(const OccupancyGrid& map, const Pose2& world_from_map, const OccupancyGrid& truth,
+                            const cv::Mat1b& observed);
+
 struct TrajectoryError {
   int poses = 0;
   double position_rmse = 0.0;  // metres

@@ -8,6 +8,10 @@
 #include "hidden_rooms/occupancy_grid.h"
 #include "hidden_rooms/range_scan.h"
 
+namespace mrpt::obs {
+class CObservation2DRangeScan;
+}
+
 namespace hidden_rooms {
 
 struct RbpfMapperOptions {
@@ -43,17 +47,21 @@ class RbpfMapper {
   // last update. Returns true when the scan was inserted into the map. Throws InputError for a scan without
   // beams or with a non-finite geometry.
   bool addScan(const Pose2& odometry, const RangeScan& scan);
+  // The same with a scan already in MRPT's form (ROS messages: hidden_rooms/ros/mrpt_scan.h, mrpt-ros1bridge);
+  // its sensorPose is the laser in base_link. Throws InputError for a scan without beams.
+  bool addScan(const Pose2& odometry, const mrpt::obs::CObservation2DRangeScan& scan);
 
   int scansAdded() const;
   int scansInserted() const;
-  // The pose estimate of base_link in the map frame (weighted mean of the particles plus the odometry since the
-  // last update); the first odometry pose before any scan.
+  // The pose estimate of base_link in the map frame: the pose (with the odometry since the filter's last update)
+  // of the particle whose grid map() returns, so that pose and map agree; the first odometry pose before any scan.
   Pose2 pose() const;
   // map -> odom (REP-105): the transform that puts the last odometry pose at pose().
   Pose2 mapToOdom() const;
   std::vector<RbpfParticle> particles() const;
-  // The grid of the most likely particle (-1 never observed, else 0..100 = occupancy probability in percent),
-  // in the map frame. Empty before the first scan.
+  // The published grid in the map frame (-1 never observed, else 0..100 = occupancy probability in percent):
+  // every inserted scan drawn along the path of the most likely particle with the [PublishedMap] certainties of
+  // the ini. Empty before the first inserted scan.
   OccupancyGrid map() const;
 
  private:

@@ -96,6 +96,30 @@ MapQuality evaluateMap(const OccupancyGrid& map, const Pose2& world_from_map, co
   return quality;
 }
 
+cv::Mat3b drawMapComparison(const OccupancyGrid& map, const Pose2& world_from_map, const OccupancyGrid& truth,
+                            const cv::Mat1b& observed) {
+  const Pose2 map_from_world = invertPose(world_from_map);
+  cv::Mat3b picture(truth.height(), truth.width(), cv::Vec3b(160, 160, 160));
+  for (int row = 0; row < truth.height(); ++row) {
+    for (int col = 0; col < truth.width(); ++col) {
+      const int8_t true_value = truth.cells(row, col);
+      const bool truly_free = isFree(true_value) && (observed.empty() || observed(row, col) != 0);
+      int map_col = 0, map_row = 0;
+      const int8_t mapped = !map.empty() && map.cellOf(transformPoint(map_from_world, truth.cellCentre(col, row)),
+                                                       &map_col, &map_row)
+                                ? map.cells(map_row, map_col)
+                                : OccupancyGrid::kUnknown;
+      cv::Vec3b& pixel = picture(row, col);
+      if (truly_free && isFree(mapped)) pixel = {255, 255, 255};
+      else if (truly_free && isOccupied(mapped)) pixel = {255, 0, 255};
+      else if (truly_free) pixel = mapped < 0 ? cv::Vec3b(0, 165, 255) : cv::Vec3b(0, 0, 255);
+      else if (isFree(mapped)) pixel = {255, 0, 0};
+      else if (isOccupied(true_value)) pixel = {0, 0, 0};
+    }
+  }
+  return picture;
+}
+
 TrajectoryError trajectoryError(const std::vector<Pose2>& estimate, const std::vector<Pose2>& truth,
                                 const Pose2& world_from_map) {
   TrajectoryError error;

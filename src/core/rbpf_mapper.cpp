@@ -5,6 +5,7 @@
 #include <exception>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 
 #include <mrpt/config/CConfigFile.h>
 #include <mrpt/core/format.h>
@@ -54,6 +55,23 @@ mrpt::obs::CActionRobotMovement2D::TMotionModelOptions readMotionModel(const mrp
   return model;
 }
 
+// Insertion options of the published grid ([PublishedMap], see config/rbpf.ini): those of the filter's grid with
+// its own update certainties.
+mrpt::maps::COccupancyGridMap2D::TInsertionOptions readPublishedInsertion(
+    const mrpt::config::CConfigFileBase& ini, const std::string& file,
+    mrpt::maps::COccupancyGridMap2D::TInsertionOptions insertion) {
+  const std::string section = "PublishedMap";
+  insertion.maxOccupancyUpdateCertainty =
+      ini.read_float(section, "maxOccupancyUpdateCertainty", insertion.maxOccupancyUpdateCertainty);
+  insertion.maxFreenessUpdateCertainty =
+      ini.read_float(section, "maxFreenessUpdateCertainty", insertion.maxFreenessUpdateCertainty);
+  const auto certain = [](float value) { return value > 0.5f && value < 1.0f; };
+  if (!certain(insertion.maxOccupancyUpdateCertainty) ||
+      !(insertion.maxFreenessUpdateCertainty == 0.0f || certain(insertion.maxFreenessUpdateCertainty)))
+    throw InputError(file, "[PublishedMap] certainties must be in (0.5, 1) (maxFreenessUpdateCertainty 0: as occupancy)");
+  return insertion;
+}
+
 }  // namespace
 
 struct RbpfMapper::Impl {
@@ -63,6 +81,20 @@ struct RbpfMapper::Impl {
   Pose2 last_odometry;
   int added = 0;
   int inserted = 0;
+
+  // The published map: every inserted scan drawn again along the path of the particle whose grid MRPT calls the
+  // most likely one, with the [PublishedMap] certainties (as gmapping renders its map from the best particle's
+  // trajectory). Scans and their index in the particles' paths, in insertion order.
+  mrpt::maps::COccupancyGridMap2D::TInsertionOptions published_insertion;
+  std::vector<mrpt::obs::CObservation2DRangeScan::Ptr> inserted_scans;
+  std::vector<size_t> inserted_path_index;
+  // Cache of the last rendering: the grid and the poses it drew the first scans at (a new best particle whose
+  // path starts with the same poses only adds the new scans).
+  mutable std::optional<mrpt::maps::COccupancyGridMap2D> rendered;
+  mutable std::vector<mrpt::math::TPose3D> rendered_poses;
+
+  size_t mappedParticle() const;
+  const mrpt::maps::COccupancyGridMap2D& publishedGrid() const;
 };
 
 RbpfMapper::RbpfMapper(const RbpfMapperOptions& options) : impl_(std::make_unique<Impl>()) {
@@ -76,6 +108,11 @@ RbpfMapper::RbpfMapper(const RbpfMapperOptions& options) : impl_(std::make_uniqu
     if (!ini.sectionExists(options.section)) throw InputError(file, "no section [" + options.section + "]");
     construction.loadFromConfigFile(ini, options.section);
     impl_->motion_model = readMotionModel(ini, file);
+    for (const auto& initializer : construction.mapsInitializers)
+      if (const auto* grid = dynamic_cast<const mrpt::maps::COccupancyGridMap2D::TMapDefinition*>(initializer.get())) {
+        impl_->published_insertion = readPublishedInsertion(ini, file, grid->insertionOpts);
+        break;
+      }
   } catch (const InputError&) {
     throw;
   } catch (const std::exception& error) {
@@ -104,9 +141,34 @@ RbpfMapper::~RbpfMapper() = default;
 
 bool RbpfMapper::addScan(const Pose2& odometry, const RangeScan& scan) {
   if (scan.ranges.empty()) throw InputError("scan", "has no beams");
-  if (!finite(odometry) || !finite(scan.sensor_pose) || !std::isfinite(scan.angle_min) ||
-      !std::isfinite(scan.angle_increment) || scan.angle_increment == 0.0 || !(scan.range_max > 0.0))
+  if (!finite(scan.sensor_pose) || !std::isfinite(scan.angle_min) || !std::isfinite(scan.angle_increment) ||
+      scan.angle_increment == 0.0 || !(scan.range_max > 0.0))
     throw InputError("scan", "non-finite pose or bad beam geometry");
+  // Scan as MRPT wants it: beams from -aperture/2 to +aperture/2 counter-clockwise, the sensor yawed to the
+  // middle of the scan (as toMrptScan does for ROS messages).
+  const size_t n = scan.ranges.size();
+  const bool reversed = scan.angle_increment < 0.0;
+  const double aperture = std::abs(scan.angle_increment) * static_cast<double>(n - 1);
+  const double first = reversed ? scan.angle_min + scan.angle_increment * static_cast<double>(n - 1) : scan.angle_min;
+  mrpt::obs::CObservation2DRangeScan observation;
+  observation.aperture = static_cast<float>(n > 1 ? aperture : 0.0);
+  observation.rightToLeft = true;
+  observation.maxRange = static_cast<float>(scan.range_max);
+  observation.sensorPose = mrpt::poses::CPose3D(mrpt::poses::CPose2D(
+      scan.sensor_pose.x, scan.sensor_pose.y, scan.sensor_pose.yaw + first + 0.5 * aperture));
+  observation.resizeScan(n);
+  for (size_t i = 0; i < n; ++i) {
+    const size_t k = reversed ? n - 1 - i : i;
+    const bool valid = std::isfinite(scan.ranges[k]) && scan.valid(k);
+    observation.setScanRange(i, valid ? scan.ranges[k] : static_cast<float>(scan.range_max));
+    observation.setScanRangeValidity(i, valid);
+  }
+  return addScan(odometry, observation);
+}
+
+bool RbpfMapper::addScan(const Pose2& odometry, const mrpt::obs::CObservation2DRangeScan& scan) {
+  if (scan.getScanSize() == 0) throw InputError("scan", "has no beams");
+  if (!finite(odometry)) throw InputError("scan", "non-finite odometry pose");
   Impl& impl = *impl_;
   if (!impl.started) {
     mrpt::poses::CPosePDFGaussian start(toMrpt(odometry));
@@ -114,26 +176,7 @@ bool RbpfMapper::addScan(const Pose2& odometry, const RangeScan& scan) {
     impl.last_odometry = odometry;
     impl.started = true;
   }
-
-  // Scan as MRPT wants it: beams from -aperture/2 to +aperture/2 counter-clockwise, the sensor yawed to the
-  // middle of the scan (as mrpt::ros1bridge::fromROS converts a sensor_msgs/LaserScan).
-  const size_t n = scan.ranges.size();
-  const bool reversed = scan.angle_increment < 0.0;
-  const double aperture = std::abs(scan.angle_increment) * static_cast<double>(n - 1);
-  const double first = reversed ? scan.angle_min + scan.angle_increment * static_cast<double>(n - 1) : scan.angle_min;
-  auto observation = std::make_shared<mrpt::obs::CObservation2DRangeScan>();
-  observation->aperture = static_cast<float>(n > 1 ? aperture : 0.0);
-  observation->rightToLeft = true;
-  observation->maxRange = static_cast<float>(scan.range_max);
-  observation->sensorPose = mrpt::poses::CPose3D(mrpt::poses::CPose2D(
-      scan.sensor_pose.x, scan.sensor_pose.y, scan.sensor_pose.yaw + first + 0.5 * aperture));
-  observation->resizeScan(n);
-  for (size_t i = 0; i < n; ++i) {
-    const size_t k = reversed ? n - 1 - i : i;
-    const bool valid = std::isfinite(scan.ranges[k]) && scan.valid(k);
-    observation->setScanRange(i, valid ? scan.ranges[k] : static_cast<float>(scan.range_max));
-    observation->setScanRangeValidity(i, valid);
-  }
+  auto observation = std::make_shared<mrpt::obs::CObservation2DRangeScan>(scan);
   mrpt::obs::CSensoryFrame frame;
   frame.insert(observation);
 
@@ -148,6 +191,10 @@ bool RbpfMapper::addScan(const Pose2& odometry, const RangeScan& scan) {
   ++impl.added;
   const bool was_inserted = impl.builder->m_statsLastIteration.observationsInserted;
   impl.inserted += was_inserted;
+  if (was_inserted) {
+    impl.inserted_scans.push_back(observation);
+    impl.inserted_path_index.push_back(impl.builder->mapPDF.m_particles.front().d->robotPath.size() - 1);
+  }
   return was_inserted;
 }
 
@@ -171,36 +218,59 @@ std::vector<RbpfParticle> RbpfMapper::particles() const {
   return result;
 }
 
+// The particle whose map getCurrentlyBuiltMetricMap() returns (MRPT picks the largest weight), so that the pose
+// and the map published with it come from the same particle.
+size_t RbpfMapper::Impl::mappedParticle() const {
+  const mrpt::maps::CMultiMetricMap* mapped = builder->getCurrentlyBuiltMetricMap();
+  const auto& all = builder->mapPDF.m_particles;
+  for (size_t i = 0; i < all.size(); ++i)
+    if (&all[i].d->mapTillNow == mapped) return i;
+  return 0;
+}
+
 Pose2 RbpfMapper::pose() const {
   if (!impl_->started) return impl_->last_odometry;
   const std::vector<RbpfParticle> all = particles();
   if (all.empty()) return impl_->last_odometry;
-  // Weighted mean; the yaw as the direction of the weighted sum of unit vectors.
-  double x = 0.0, y = 0.0, c = 0.0, s = 0.0;
-  for (const RbpfParticle& p : all) {
-    x += p.weight * p.pose.x;
-    y += p.weight * p.pose.y;
-    c += p.weight * std::cos(p.pose.yaw);
-    s += p.weight * std::sin(p.pose.yaw);
-  }
-  return {x, y, std::atan2(s, c)};
+  const size_t mapped = impl_->mappedParticle();
+  return all[mapped < all.size() ? mapped : 0].pose;
 }
 
 Pose2 RbpfMapper::mapToOdom() const { return composePoses(pose(), invertPose(impl_->last_odometry)); }
 
+const mrpt::maps::COccupancyGridMap2D& RbpfMapper::Impl::publishedGrid() const {
+  const auto& path = builder->mapPDF.m_particles[mappedParticle()].d->robotPath;
+  size_t same = 0;  // leading scans already drawn at the same poses
+  while (same < rendered_poses.size() && same < inserted_scans.size() &&
+         path[inserted_path_index[same]] == rendered_poses[same])
+    ++same;
+  if (!rendered || same < rendered_poses.size()) {  // another path: draw all scans again
+    const auto filter_grid = builder->getCurrentlyBuiltMetricMap()->mapByClass<mrpt::maps::COccupancyGridMap2D>(0);
+    rendered.emplace(filter_grid->getXMin(), filter_grid->getXMax(), filter_grid->getYMin(), filter_grid->getYMax(),
+                     filter_grid->getResolution());
+    rendered->insertionOptions = published_insertion;
+    rendered_poses.clear();
+  }
+  for (size_t k = rendered_poses.size(); k < inserted_scans.size(); ++k) {
+    const mrpt::math::TPose3D& pose = path[inserted_path_index[k]];
+    rendered->insertObservation(*inserted_scans[k], mrpt::poses::CPose3D(pose));
+    rendered_poses.push_back(pose);
+  }
+  return *rendered;
+}
+
 OccupancyGrid RbpfMapper::map() const {
   OccupancyGrid grid;
-  if (!impl_->started) return grid;
-  const mrpt::maps::CMultiMetricMap* maps = impl_->builder->getCurrentlyBuiltMetricMap();
-  const auto mrpt_grid = maps->mapByClass<mrpt::maps::COccupancyGridMap2D>(0);
-  const int width = static_cast<int>(mrpt_grid->getSizeX()), height = static_cast<int>(mrpt_grid->getSizeY());
-  grid.resolution = shortest(mrpt_grid->getResolution());
-  grid.origin = Point2(shortest(mrpt_grid->getXMin()), shortest(mrpt_grid->getYMin()));
+  if (!impl_->started || impl_->inserted_scans.empty()) return grid;
+  const mrpt::maps::COccupancyGridMap2D& mrpt_grid = impl_->publishedGrid();
+  const int width = static_cast<int>(mrpt_grid.getSizeX()), height = static_cast<int>(mrpt_grid.getSizeY());
+  grid.resolution = shortest(mrpt_grid.getResolution());
+  grid.origin = Point2(shortest(mrpt_grid.getXMin()), shortest(mrpt_grid.getYMin()));
   grid.cells.create(height, width);
   for (int y = 0; y < height; ++y) {
     const int row = height - 1 - y;  // MRPT's row 0 is the bottom
     for (int x = 0; x < width; ++x) {
-      const float free_probability = mrpt_grid->getCell(x, y);  // 0.5 exactly: never observed
+      const float free_probability = mrpt_grid.getCell(x, y);  // 0.5 exactly: never observed
       grid.cells(row, x) = free_probability == 0.5f
                                ? OccupancyGrid::kUnknown
                                : static_cast<int8_t>(std::lround(100.0 * (1.0 - free_probability)));

@@ -20,11 +20,13 @@
 
 #include "hidden_rooms/command_line.h"
 #include "hidden_rooms/environment.h"
+#include "hidden_rooms/image_io.h"
 #include "hidden_rooms/input_error.h"
 #include "hidden_rooms/map_quality.h"
 #include "hidden_rooms/rbpf_mapper.h"
 #include "hidden_rooms/render.h"
 #include "hidden_rooms/ros/conversions.h"
+#include "hidden_rooms/ros/mrpt_scan.h"
 
 namespace po = boost::program_options;
 using hidden_rooms::InputError;
@@ -60,7 +62,7 @@ std::string defaultConfig() {
 
 int run(int argc, char** argv) {
   std::string bag_path, prefix, config, scan_topic, odom_frame, base_frame, environment_path, closed, metrics_path,
-      truth_topic;
+      truth_topic, comparison_path;
   int seed = 0;
   bool quiet = false;
   po::options_description options("Options");
@@ -77,6 +79,9 @@ int run(int argc, char** argv) {
       ("truth-topic", po::value(&truth_topic)->default_value("base_pose_ground_truth"),
        "with --environment: nav_msgs/Odometry of the true pose in the world frame")
       ("metrics", po::value(&metrics_path), "with --environment: also write the figures to this YAML file")
+      ("comparison", po::value(&comparison_path),
+       "with --environment: PNG of the map on the truth (white: both free; orange / red / magenta: observed free the "
+       "map has unknown / uncertain / occupied; blue: map free where the truth is not observed free)")
       ("quiet", po::bool_switch(&quiet), "no progress line");
   po::positional_options_description positional;
   positional.add("bag", 1);
@@ -93,6 +98,7 @@ int run(int argc, char** argv) {
   if (config.empty()) config = defaultConfig();
   if (config.empty()) throw InputError("--config", "not given and the package's config/rbpf.ini was not found");
   if (!metrics_path.empty() && environment_path.empty()) throw InputError("--metrics", "needs --environment");
+  if (!comparison_path.empty() && environment_path.empty()) throw InputError("--comparison", "needs --environment");
 
   // Inputs first: nothing is written on bad input.
   hidden_rooms::RenderedEnvironment truth;
@@ -140,13 +146,12 @@ int run(int argc, char** argv) {
           hidden_rooms::fromRos(tf_buffer.lookupTransform(odom_frame, base_frame, scan.header.stamp).transform);
       const Pose2 sensor =
           hidden_rooms::fromRos(tf_buffer.lookupTransform(base_frame, scan.header.frame_id, ros::Time(0)).transform);
-      const hidden_rooms::RangeScan range_scan = hidden_rooms::fromRos(scan, sensor);
-      const bool inserted = mapper.addScan(odometry, range_scan);
+      const bool inserted = mapper.addScan(odometry, hidden_rooms::toMrptScan(scan, sensor));
       ++processed;
       if (!environment_path.empty()) {
         scan_times.push_back(scan.header.stamp.toSec());
         estimate.push_back(mapper.pose());
-        if (inserted) inserted_scans.emplace_back(scan.header.stamp.toSec(), range_scan);
+        if (inserted) inserted_scans.emplace_back(scan.header.stamp.toSec(), hidden_rooms::fromRos(scan, sensor));
       }
     } catch (const tf2::TransformException& error) {
       ++dropped;
@@ -208,6 +213,8 @@ int run(int argc, char** argv) {
     hidden_rooms::markObservedCells(truth.map, hidden_rooms::composePoses(interpolate(true_poses, time), scan.sensor_pose),
                                     scan, &observed);
   const hidden_rooms::MapQuality quality = hidden_rooms::evaluateMap(map, world_from_map, truth.map, observed);
+  if (!comparison_path.empty())
+    hidden_rooms::writeImage(comparison_path, hidden_rooms::drawMapComparison(map, world_from_map, truth.map, observed));
   const hidden_rooms::TrajectoryError trajectory = hidden_rooms::trajectoryError(estimate, truth_at_scans, world_from_map);
   char text[1024];
   std::snprintf(text, sizeof(text),

@@ -9,6 +9,7 @@
 #include "hidden_rooms/input_error.h"
 #include "hidden_rooms/occupancy_grid.h"
 #include "hidden_rooms/ros/conversions.h"
+#include "hidden_rooms/ros/mrpt_scan.h"
 
 namespace hidden_rooms {
 
@@ -96,7 +97,7 @@ bool Mapper::process(const sensor_msgs::LaserScan& scan) {
     return false;
   }
   try {
-    mapper_->addScan(odometry, fromRos(scan, sensor));
+    mapper_->addScan(odometry, toMrptScan(scan, sensor));
   } catch (const InputError& error) {
     ROS_WARN_THROTTLE(5.0, "mapper: bad scan: %s", error.what());
     ++dropped_;

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include <boost/make_shared.hpp>
 #include <boost/program_options.hpp>
 #include <rosbag/bag.h>
 #include <tf2_msgs/TFMessage.h>
@@ -67,7 +68,17 @@ int run(int argc, char** argv) {
   tf2_msgs::TFMessage fixed;
   fixed.transforms.push_back(hidden_rooms::toTransform(simulation_options.laser.mount, "base_link", "base_laser_link",
                                                         ros::Time(dt)));
-  bag.write("/tf_static", ros::Time(dt), fixed);
+  // Latched, as tf2's static broadcaster publishes it: rosbag play then latches it too, so that nodes started
+  // with the replay (replay.launch) still get the laser mount.
+  // (A given connection header replaces rosbag's own, so it carries the message's type fields too.)
+  auto latched = boost::make_shared<ros::M_string>();
+  (*latched)["topic"] = "/tf_static";
+  (*latched)["type"] = ros::message_traits::datatype(fixed);
+  (*latched)["md5sum"] = ros::message_traits::md5sum(fixed);
+  (*latched)["message_definition"] = ros::message_traits::definition(fixed);
+  (*latched)["latching"] = "1";
+  (*latched)["callerid"] = "/record_simulation_bag";
+  bag.write("/tf_static", ros::Time(dt), fixed, latched);
   for (int k = 1; k <= steps; ++k) {
     simulation.step();
     const ros::Time stamp(simulation.time());
