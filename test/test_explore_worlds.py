@@ -9,9 +9,11 @@ roslaunch; skips without them, unless HIDDEN_ROOMS_REQUIRE_SHARED=1 (scripts/tes
 import csv
 import os
 import shutil
+import signal
 import subprocess
 import sys
 import tempfile
+import time
 import unittest
 
 import yaml
@@ -66,6 +68,52 @@ class ExploreWorldsTest(unittest.TestCase):
         with open(os.path.join(run_dir, "doors.yaml")) as doors_file:
             doors = yaml.safe_load(doors_file)["doors"]
         self.assertEqual([door["id"] for door in doors], [1])
+
+    def test_a_rerun_keeps_the_finished_world(self):
+        self.assertEqual(self.result.returncode, 0, self.result.stdout + self.result.stderr)
+        with open(os.path.join(self.out, "summary.csv")) as summary_file:
+            before = list(csv.DictReader(summary_file))
+        again = run(WORLD, "--out", self.out, "--closed", "1", "--timeout", "25", "--growth", "0", "--max-time", "300",
+                    timeout=60)
+        self.assertEqual(again.returncode, 0, again.stdout + again.stderr)
+        self.assertIn("kept from an earlier run", again.stdout)
+        with open(os.path.join(self.out, "summary.csv")) as summary_file:
+            after = list(csv.DictReader(summary_file))
+        self.assertEqual(len(after), 1)
+        self.assertEqual({k: v for k, v in before[0].items() if k != "message"},
+                         {k: v for k, v in after[0].items() if k != "message"})
+
+    def test_sigkill_leaves_no_process_and_a_rerun_finishes(self):
+        out = tempfile.mkdtemp(prefix="hidden_rooms_explore_worlds_kill_")
+        try:
+            arguments = [WORLD, "--out", out, "--closed", "1", "--timeout", "25", "--growth", "0", "--max-time", "300"]
+            started = subprocess.Popen([sys.executable, SCRIPT] + arguments, stdout=subprocess.DEVNULL,
+                                       stderr=subprocess.DEVNULL)
+            log_dir = os.path.join(out, "simulator_corridor")
+            deadline = time.monotonic() + 60
+            while time.monotonic() < deadline and not os.path.isfile(os.path.join(log_dir, "poses_map.log")):
+                time.sleep(0.5)
+            self.assertTrue(os.path.isfile(os.path.join(log_dir, "poses_map.log")), "the run did not start")
+            started.send_signal(signal.SIGKILL)
+            started.wait()
+            deadline = time.monotonic() + 30
+            while time.monotonic() < deadline and self.processes_of(out):
+                time.sleep(0.5)
+            self.assertEqual(self.processes_of(out), [], "processes left behind")
+            again = run(*arguments)
+            self.assertEqual(again.returncode, 0, again.stdout + again.stderr)
+            with open(os.path.join(out, "summary.csv")) as summary_file:
+                rows = list(csv.DictReader(summary_file))
+            self.assertEqual(len(rows), 1)
+            self.assertIn(rows[0]["status"], ("done", "no_growth"), rows[0])
+        finally:
+            shutil.rmtree(out, ignore_errors=True)
+
+    @staticmethod
+    def processes_of(out):
+        """Command lines of running processes that name `out` (the worker, roslaunch and its nodes)."""
+        found = subprocess.run(["pgrep", "-af", out], capture_output=True, text=True).stdout
+        return [line for line in found.splitlines() if "pgrep" not in line]
 
     def test_bad_input_exits_2_with_a_message(self):
         missing = run(os.path.join(self.out, "no_such_world.xml"), "--out", self.out)

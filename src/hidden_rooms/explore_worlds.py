@@ -7,12 +7,17 @@ by less than --growth over the one before, or at --max-time. Then the final map,
 into the map frame (translate_doors, METHOD.md §2), the run's scores against its world and, with --method, the
 predicted rooms and their IoU are written. DIR/summary.csv has one row per world.
 
+A re-run keeps the worlds already finished with the same settings (DIR/WORLD/result.json, written atomically)
+and runs the others again. Every child process gets SIGTERM when its parent dies, so a run killed even by SIGKILL
+leaves no master, simulator or mapper behind.
+
 `scripts/explore_worlds` is the command line (see `main`); each world runs in a worker process
 (`--worker`) whose ROS_MASTER_URI names its own master.
 """
 import argparse
 import concurrent.futures
 import csv
+import ctypes
 import glob
 import json
 import os
@@ -34,8 +39,21 @@ RESULT_NAME = "result.json"
 SUMMARY_COLUMNS = ["world", "status", "closed_doors", "sim_time_s", "wall_time_s", "path_length_m", "coverage",
                    "free_iou", "worst_door_error_m", "mean_iou", "message"]
 MASTER_START_TIMEOUT = 60.0   # wall seconds for roslaunch's master and the simulator's clock
+PR_SET_PDEATHSIG = 1          # prctl option (linux/prctl.h)
 STALL_TIMEOUT = 60.0          # wall seconds without simulated time advancing: the run is stuck
 SHUTDOWN_TIMEOUT = 20.0       # wall seconds for roslaunch to stop after SIGINT
+
+
+def die_with_parent():
+    """preexec_fn of the children: SIGTERM when the process that started them dies (even by SIGKILL), so that a
+    killed run leaves no simulator, mapper or master behind."""
+    ctypes.CDLL("libc.so.6", use_errno=True).prctl(PR_SET_PDEATHSIG, signal.SIGTERM)
+
+
+def write_json_atomically(path, value):
+    with open(path + ".partial", "w") as partial:
+        json.dump(value, partial, indent=1)
+    os.replace(path + ".partial", path)
 
 
 def free_port():
@@ -149,7 +167,8 @@ def explore(args, out_dir, log):
                "seed:=%d" % args.seed, "gui:=%s" % ("true" if args.gui else "false")]
     if args.bag:
         command.append("bag:=%s" % os.path.join(out_dir, "run.bag"))
-    launch = subprocess.Popen(command, stdout=log, stderr=subprocess.STDOUT, start_new_session=True)
+    launch = subprocess.Popen(command, stdout=log, stderr=subprocess.STDOUT, start_new_session=True,
+                              preexec_fn=die_with_parent)
     try:
         wait_for_master(launch, time.monotonic() + MASTER_START_TIMEOUT)
         run = Run(world_name(args.world))
@@ -268,8 +287,8 @@ def run_worker(args):
         except (RuntimeError, OSError, ToolError) as error:
             result["message"] = str(error)
             result["wall_time_s"] = round(time.monotonic() - started, 1)
-    with open(os.path.join(out_dir, RESULT_NAME), "w") as result_file:
-        json.dump(result, result_file, indent=1)
+    result["settings"] = run_settings(args, args.closed)
+    write_json_atomically(os.path.join(out_dir, RESULT_NAME), result)
     return 0 if result["status"] != "failed" else 1
 
 
@@ -320,6 +339,22 @@ def worker_command(args, world, closed):
     return command + (["--bag"] if args.bag else []) + (["--gui"] if args.gui else [])
 
 
+def run_settings(args, closed):
+    """What makes two runs of a world the same run (a finished one is kept on a re-run with these)."""
+    return {"closed": closed, "timeout": args.timeout, "growth": args.growth, "max_time": args.max_time,
+            "realtime_factor": args.realtime_factor, "seed": args.seed, "method": args.method, "bag": args.bag}
+
+
+def finished_result(out_dir, settings):
+    """The result of an earlier run of this world with these settings that did not fail, else None."""
+    try:
+        with open(os.path.join(out_dir, RESULT_NAME)) as result_file:
+            result = json.load(result_file)
+    except (OSError, ValueError):
+        return None
+    return result if result.get("status") != "failed" and result.get("settings") == settings else None
+
+
 def explore_one(args, world):
     """Runs a worker for `world` with its own master; returns its result dictionary."""
     env = dict(os.environ, ROS_MASTER_URI="http://127.0.0.1:%d" % free_port(),
@@ -330,8 +365,13 @@ def explore_one(args, world):
         closed = closed_doors_of(args.closed, world, args.seed)
     except ToolError as error:
         return {"world": world, "status": "failed", "message": str(error)}
+    kept = finished_result(out_dir, run_settings(args, closed))
+    if kept is not None:
+        kept["message"] = "kept from an earlier run"
+        return kept
     with open(os.path.join(out_dir, "worker.log"), "w") as log:
-        subprocess.run(worker_command(args, world, closed), env=env, stdout=log, stderr=subprocess.STDOUT)
+        subprocess.run(worker_command(args, world, closed), env=env, stdout=log, stderr=subprocess.STDOUT,
+                       preexec_fn=die_with_parent)
     try:
         with open(os.path.join(out_dir, RESULT_NAME)) as result_file:
             return json.load(result_file)
