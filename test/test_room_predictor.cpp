@@ -188,7 +188,8 @@ TEST(RoomPredictor, WritesTheCompletedMapAsAnOctomap) {
   const auto completed =
       ros::topic::waitForMessage<nav_msgs::OccupancyGrid>("octomap/predicted_map", nh, ros::Duration(60.0));
   ASSERT_TRUE(completed != nullptr);
-  const std::string path = "/tmp/hidden_rooms_test_room_predictor_octomap/predicted.ot";
+  std::string path;
+  ASSERT_TRUE(nh.getParam("/octomap/room_predictor/octomap_out", path));
   const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(60.0);
   while (!std::filesystem::exists(path) && ros::WallTime::now() < deadline) ros::WallDuration(0.1).sleep();
   ASSERT_TRUE(std::filesystem::exists(path)) << "no 3D map written";
