@@ -82,6 +82,10 @@ TEST(MrptScan, NanInfinityAndOutOfRangeBeamsAreInvalid) {
     EXPECT_TRUE(std::isfinite(scan.getScanRange(i))) << i;
   }
   EXPECT_TRUE(scan.getScanRangeValidity(15));
+  EXPECT_EQ(countValidRanges(message), message.ranges.size() - 5);
+  // A scan of nothing but such beams has no valid range (the mapper ignores it).
+  for (size_t i = 0; i < message.ranges.size(); ++i) message.ranges[i] = message.ranges[10 + i % 5];
+  EXPECT_EQ(countValidRanges(message), 0u);
 }
 
 TEST(MrptScan, BadMessagesGiveClearErrors) {

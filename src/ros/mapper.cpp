@@ -29,12 +29,14 @@ MapperOptions readMapperOptions(const ros::NodeHandle& nh) {
   nh.param("tf_publish_rate", options.tf_publish_rate, options.tf_publish_rate);
   nh.param("transform_tolerance", options.transform_tolerance, options.transform_tolerance);
   nh.param("tf_wait", options.tf_wait, options.tf_wait);
+  nh.param("future_stamp_tolerance", options.future_stamp_tolerance, options.future_stamp_tolerance);
   nh.param("publish_particles", options.publish_particles, options.publish_particles);
   if (options.rbpf.config_file.empty()) throw InputError("~config_file", "must name the MRPT ini (config/rbpf.ini)");
   for (const auto& [name, value] : {std::pair<const char*, double>{"map_update_interval", options.map_update_interval},
                                     {"tf_publish_rate", options.tf_publish_rate},
                                     {"transform_tolerance", options.transform_tolerance},
-                                    {"tf_wait", options.tf_wait}})
+                                    {"tf_wait", options.tf_wait},
+                                    {"future_stamp_tolerance", options.future_stamp_tolerance}})
     if (!std::isfinite(value) || value < 0.0) throw InputError(std::string("~") + name, "must be zero or positive");
   for (const std::string* frame : {&options.map_frame, &options.odom_frame, &options.base_frame})
     if (frame->empty()) throw InputError("~map_frame, ~odom_frame, ~base_frame", "must not be empty");
@@ -55,14 +57,34 @@ Mapper::Mapper(ros::NodeHandle nh, const MapperOptions& options)
     tf_timer_ = nh.createTimer(ros::Duration(1.0 / options.tf_publish_rate), &Mapper::onTimer, this);
 }
 
+// Scans that would harm the filter are ignored on arrival, each kind with its own throttled warning: stamps
+// before the last scan's (the filter cannot go back), stamps too far ahead of ROS time (they would make every
+// later scan look old), and scans without a valid range (NaN, infinite, out of range: nothing to match or insert,
+// and the filter would spend an update and an insertion on them).
 void Mapper::onScan(const sensor_msgs::LaserScan::ConstPtr& scan) {
-  if (!last_scan_stamp_.isZero() && scan->header.stamp < last_scan_stamp_) {
-    // Time went back (a bag restarted, the simulator was reset with a new clock): the filter cannot go back.
-    ROS_WARN_THROTTLE(5.0, "mapper: scan stamped %.3f before the last one (%.3f); ignored",
-                      scan->header.stamp.toSec(), last_scan_stamp_.toSec());
+  const ros::Time stamp = scan->header.stamp;
+  if (!last_scan_stamp_.isZero() && stamp < last_scan_stamp_) {
+    // Time went back (a bag restarted, the simulator was reset with a new clock, a stale message).
+    ++ignored_;
+    ROS_WARN_THROTTLE(5.0, "mapper: scan stamped %.3f before the last one (%.3f); ignored (%d scans ignored so far)",
+                      stamp.toSec(), last_scan_stamp_.toSec(), ignored_);
     return;
   }
-  last_scan_stamp_ = scan->header.stamp;
+  const ros::Time now = ros::Time::now();
+  if (options_.future_stamp_tolerance > 0.0 && !now.isZero() &&
+      (stamp - now).toSec() > options_.future_stamp_tolerance) {
+    ++ignored_;
+    ROS_WARN_THROTTLE(5.0, "mapper: scan stamped %.3f, %.1f s ahead of ROS time %.3f; ignored (%d scans ignored so far)",
+                      stamp.toSec(), (stamp - now).toSec(), now.toSec(), ignored_);
+    return;
+  }
+  if (countValidRanges(*scan) == 0) {
+    ++ignored_;
+    ROS_WARN_THROTTLE(5.0, "mapper: scan stamped %.3f has no valid range (all NaN, infinite or outside (range_min, "
+                      "range_max)); ignored (%d scans ignored so far)", stamp.toSec(), ignored_);
+    return;
+  }
+  last_scan_stamp_ = stamp;
   pending_.push_back(scan);
   processPending();
 }

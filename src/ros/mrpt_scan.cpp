@@ -44,11 +44,20 @@ mrpt::obs::CObservation2DRangeScan toMrptScan(const sensor_msgs::LaserScan& mess
   // and 0.99 range_max; NaN compares false). Invalid beams keep a finite range (range_max) for MRPT.
   for (size_t i = 0; i < n; ++i) {
     const float range = symmetric.ranges[i];
-    const bool valid = std::isfinite(range) && range > message.range_min && range < 0.99f * message.range_max;
+    const bool valid = isValidRange(message, range);
     scan.setScanRange(i, valid ? range : message.range_max);
     scan.setScanRangeValidity(i, valid);
   }
   return scan;
+}
+
+bool isValidRange(const sensor_msgs::LaserScan& message, float range) {
+  return std::isfinite(range) && range > message.range_min && range < 0.99f * message.range_max;
+}
+
+size_t countValidRanges(const sensor_msgs::LaserScan& message) {
+  return static_cast<size_t>(std::count_if(message.ranges.begin(), message.ranges.end(),
+                                           [&](float range) { return isValidRange(message, range); }));
 }
 
 }  // namespace hidden_rooms

@@ -26,6 +26,9 @@ struct MapperOptions {
   double tf_publish_rate = 20.0;      // Hz (wall-clock timer on ROS time) of map -> odom; 0 = after each scan
   double transform_tolerance = 0.1;   // seconds map -> odom is stamped ahead (as gmapping / amcl do)
   double tf_wait = 0.5;               // seconds a scan may wait for odom -> base_link at its stamp before it is dropped
+  // Seconds a scan may be stamped ahead of ROS time; later ones are ignored (one scan from a wrong clock would
+  // otherwise make every following scan look out of order). 0 = no check.
+  double future_stamp_tolerance = 1.0;
   bool publish_particles = true;      // publish `particles` (geometry_msgs/PoseArray)
 };
 
@@ -41,9 +44,11 @@ class Mapper {
   Mapper(ros::NodeHandle nh, const MapperOptions& options);
 
   const RbpfMapper& mapper() const { return *mapper_; }
-  // Scans given to the filter / dropped because their odometry never arrived.
+  // Scans given to the filter / dropped because their odometry never arrived / ignored on arrival (stamped
+  // before the last one or too far ahead, no valid range).
   int scansProcessed() const { return processed_; }
   int scansDropped() const { return dropped_; }
+  int scansIgnored() const { return ignored_; }
 
  private:
   void onScan(const sensor_msgs::LaserScan::ConstPtr& scan);
@@ -66,6 +71,7 @@ class Mapper {
   bool map_published_ = false;
   int processed_ = 0;
   int dropped_ = 0;
+  int ignored_ = 0;
   ros::Subscriber scan_subscriber_;
   ros::Publisher map_publisher_;
   ros::Publisher metadata_publisher_;

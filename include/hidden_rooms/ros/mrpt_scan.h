@@ -19,4 +19,10 @@ namespace hidden_rooms {
 // non-positive or non-finite range_max or a non-finite sensor pose.
 mrpt::obs::CObservation2DRangeScan toMrptScan(const sensor_msgs::LaserScan& message, const Pose2& sensor_pose);
 
+// True when `range` is a return of `message` by toMrptScan's rule: finite and strictly between range_min and
+// 0.99 range_max.
+bool isValidRange(const sensor_msgs::LaserScan& message, float range);
+// The beams of `message` with a valid range (0 for a scan of NaN, infinite or out-of-range values only).
+size_t countValidRanges(const sensor_msgs::LaserScan& message);
+
 }  // namespace hidden_rooms
