@@ -122,6 +122,31 @@ TEST(Frontier, NearestGoalIsTheCheaperEndAndSkipsTheBlacklist) {
   EXPECT_LT(nearestFrontierGoal(frontiers, planner, Blacklist(), options, other->position, 100.0)->position.x(), 1.0);
 }
 
+TEST(Frontier, PlacesWhereTheRobotWasStuckAreReleasedForAnotherTry) {
+  const OccupancyGrid grid = corridorWithTwoEnds();
+  GridPlanner planner;
+  planner.setMap(grid);
+  ASSERT_TRUE(planner.computeCostsFrom(Point2(7.0, 2.0)));
+  const FrontierMap frontiers = findFrontiers(grid);
+  Blacklist blacklist;
+  blacklist.radius = 3.0;
+  blacklist.add(Point2(9.8, 2.0), /*robot_stuck=*/true);  // failed while the robot could not move
+  blacklist.add(Point2(0.2, 2.0));                         // failed while it moved
+  EXPECT_FALSE(nearestFrontierGoal(frontiers, planner, blacklist, FrontierOptions()).has_value());
+  EXPECT_EQ(blacklist.releaseStuck(), 1u);
+  EXPECT_EQ(blacklist.points.size(), 1u);
+  EXPECT_TRUE(blacklist.stuck_points.empty());
+  const std::optional<FrontierGoal> goal = nearestFrontierGoal(frontiers, planner, blacklist, FrontierOptions());
+  ASSERT_TRUE(goal.has_value());
+  EXPECT_GT(goal->position.x(), 9.0);
+  EXPECT_EQ(blacklist.releaseStuck(), 0u);
+  EXPECT_FALSE(nearestFrontierGoal(frontiers, planner, [&] {
+                 Blacklist both = blacklist;
+                 both.add(goal->position);
+                 return both;
+               }(), FrontierOptions()).has_value());
+}
+
 TEST(Frontier, UnreachableFrontierGivesNoGoal) {
   // A frontier in a second room that a wall separates from the robot's.
   OccupancyGrid grid = corridorWithTwoEnds();

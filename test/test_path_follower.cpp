@@ -209,6 +209,87 @@ TEST(PathFollower, FailsWithoutProgressEvenWhenMoving) {
   EXPECT_NEAR(time, options.progress_timeout, 0.25);
 }
 
+TEST(PathFollower, HeldTimeCountsNeitherForProgressNorForTheStallWatch) {
+  PathFollowerOptions options;  // progress_timeout 20 s, stall_timeout 3 s
+  PathFollower held(options), not_held(options);
+  for (PathFollower* follower : {&held, &not_held}) {
+    follower->setPath(straightPath(5.0), 0.0);
+    follower->update(Pose2{0.0, 0.0, 0.0}, {}, 0.1);
+    follower->update(Pose2{0.4, 0.0, 0.0}, {}, 1.0);  // progress
+  }
+  // Stopped from outside for 30 s (no map): the node holds the follower on every tick.
+  const Pose2 still{0.4, 0.0, 0.0};
+  for (double time = 1.1; time < 31.0; time += 0.1) held.hold(time);
+  FollowerStep step = held.update(still, {}, 31.0);
+  EXPECT_EQ(step.state, FollowerState::kFollowing);
+  EXPECT_GT(step.command.linear, 0.0);
+  EXPECT_EQ(held.recoveries(), 0);
+  // Without the hold the same pause fails the goal at once.
+  EXPECT_EQ(not_held.update(still, {}, 31.0).state, FollowerState::kFailed);
+  // The stall watch starts afresh: a recovery only after stall_timeout more seconds without motion.
+  double time = 31.1;
+  for (; time < 31.0 + options.stall_timeout - 0.05; time += 0.1) {
+    step = held.update(still, {}, time);
+    EXPECT_EQ(step.state, FollowerState::kFollowing) << time;
+  }
+  for (; step.state == FollowerState::kFollowing && time < 31.0 + options.stall_timeout + 1.0; time += 0.1)
+    step = held.update(still, {}, time);
+  EXPECT_EQ(step.state, FollowerState::kBackingOff);
+  EXPECT_EQ(held.recoveries(), 1);
+}
+
+TEST(PathFollower, AHeldRecoveryGoesOnForTheRestOfItsTime) {
+  PathFollowerOptions options;  // backoff_time 1.5 s
+  PathFollower follower(options);
+  follower.setPath(straightPath(5.0), 0.0);
+  const std::vector<Point2> wall = wallAhead(0.5 * options.footprint_length + 0.05);
+  const Pose2 stuck{0.5, 0.0, 0.0};
+  FollowerStep step;
+  double time = 0.0;
+  for (; step.state != FollowerState::kBackingOff && time < 10.0; time += 0.1) step = follower.update(stuck, wall, time);
+  ASSERT_EQ(step.state, FollowerState::kBackingOff);
+  const double backoff_start = time - 0.1;
+  step = follower.update(stuck, wall, backoff_start + 0.5);
+  EXPECT_EQ(step.state, FollowerState::kBackingOff);
+  // Held for 10 s half-way through: 1 s of backing off is left afterwards.
+  follower.hold(backoff_start + 0.5);
+  step = follower.update(stuck, wall, backoff_start + 10.5);
+  EXPECT_EQ(step.state, FollowerState::kBackingOff);
+  EXPECT_LT(step.command.linear, 0.0);
+  EXPECT_EQ(follower.update(stuck, wall, backoff_start + 11.3).state, FollowerState::kBackingOff);
+  EXPECT_EQ(follower.update(stuck, wall, backoff_start + 11.6).state, FollowerState::kRecoveryRotating);
+}
+
+TEST(PathFollower, CountsTheRecoveriesThatMovedNothing) {
+  PathFollowerOptions options;
+  options.max_recoveries = 2;
+  const std::vector<Point2> wall = wallAhead(0.5 * options.footprint_length + 0.05);
+  {  // Pinned: no command moves the robot; both recoveries moved nothing.
+    PathFollower follower(options);
+    follower.setPath(straightPath(5.0), 0.0);
+    FollowerStep step;
+    for (double time = 0.0; step.state != FollowerState::kFailed && time < 60.0; time += 0.1)
+      step = follower.update(Pose2{0.5, 0.0, 0.0}, wall, time);
+    EXPECT_EQ(step.state, FollowerState::kFailed);
+    EXPECT_EQ(follower.recoveries(), 2);
+    EXPECT_EQ(follower.recoveriesWithoutMotion(), 2);
+  }
+  {  // Blocked ahead but free to move: the robot follows the recovery's commands, which counts as motion.
+    PathFollower follower(options);
+    follower.setPath(straightPath(5.0), 0.0);
+    Pose2 pose{0.5, 0.0, 0.0};
+    FollowerStep step;
+    for (double time = 0.0; follower.recoveries() < 1 || step.state != FollowerState::kFollowing; time += 0.1) {
+      ASSERT_LT(time, 30.0);
+      step = follower.update(pose, wall, time);
+      pose.x += 0.1 * step.command.linear;  // a unicycle that obeys
+      pose.yaw += 0.1 * step.command.angular;
+    }
+    EXPECT_EQ(follower.recoveries(), 1);
+    EXPECT_EQ(follower.recoveriesWithoutMotion(), 0);
+  }
+}
+
 TEST(PathFollower, ObstaclePointsSkipInvalidReturnsAndApplyTheLaserPose) {
   RangeScan scan;
   scan.angle_min = -M_PI / 2;

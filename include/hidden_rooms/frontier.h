@@ -42,7 +42,14 @@ FrontierMap findFrontiers(const OccupancyGrid& map, const FrontierOptions& optio
 struct Blacklist {
   std::vector<Point2> points;
   double radius = 0.8;  // metres
+  // Of `points`, the goals that failed while the robot could not move at all (its recoveries produced no
+  // motion): the robot was stuck, the place may be fine.
+  std::vector<Point2> stuck_points;
   bool contains(const Point2& point) const;
+  // Adds a failed or reached goal; `robot_stuck` also lists it in stuck_points.
+  void add(const Point2& point, bool robot_stuck = false);
+  // Takes the stuck places off the list, so that they are tried again; returns how many there were.
+  size_t releaseStuck();
 };
 
 struct FrontierGoal {

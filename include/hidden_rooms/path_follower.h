@@ -108,6 +108,10 @@ class PathFollower {
   // Keeps following the new path of the same goal (a replan): progress and recovery counters stay.
   void updatePath(const std::vector<Point2>& path);
   void stop();
+  // The robot is held still from outside at `time` (the node stops it while its map, pose or scan is stale).
+  // The held time, up to the next update, counts neither for the progress timeout nor for the stall watch, and a
+  // recovery manoeuvre in progress goes on for the rest of its duration.
+  void hold(double time);
 
   // The command for the robot at `pose` (map frame) with obstacle points (metres, base_link). kGoalReached and
   // kFailed stay (with zero commands) until the next setPath.
@@ -115,6 +119,9 @@ class PathFollower {
 
   FollowerState state() const { return state_; }
   int recoveries() const { return recoveries_; }
+  // Recoveries since setPath after which the robot had neither moved stall_distance nor turned stall_angle
+  // from where the recovery started: its commands produced no motion (the robot is pinned, or its drive is off).
+  int recoveriesWithoutMotion() const { return recoveries_without_motion_; }
   const std::vector<Point2>& path() const { return path_; }
   const PathFollowerOptions& options() const { return options_; }
 
@@ -146,7 +153,12 @@ class PathFollower {
   bool anchor_set_ = false;
   double recovery_until_ = 0.0;
   double recovery_turn_sign_ = 1.0;
+  Pose2 recovery_start_pose_;
   int recoveries_ = 0;
+  int recoveries_without_motion_ = 0;
+  // Held from outside since held_since_ (hold()).
+  bool held_ = false;
+  double held_since_ = 0.0;
 };
 
 }  // namespace hidden_rooms

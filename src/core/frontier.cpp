@@ -66,6 +66,20 @@ bool Blacklist::contains(const Point2& point) const {
                      [&](const Point2& listed) { return (listed - point).norm() <= radius; });
 }
 
+void Blacklist::add(const Point2& point, bool robot_stuck) {
+  points.push_back(point);
+  if (robot_stuck) stuck_points.push_back(point);
+}
+
+size_t Blacklist::releaseStuck() {
+  const size_t released = stuck_points.size();
+  for (const Point2& stuck : stuck_points)
+    points.erase(std::remove_if(points.begin(), points.end(), [&](const Point2& listed) { return listed == stuck; }),
+                 points.end());
+  stuck_points.clear();
+  return released;
+}
+
 std::optional<FrontierGoal> nearestFrontierGoal(const FrontierMap& frontiers, const GridPlanner& planner,
                                                 const Blacklist& blacklist, const FrontierOptions& options,
                                                 const std::optional<Point2>& previous, double hysteresis) {

@@ -132,6 +132,8 @@ void PathFollower::setPath(const std::vector<Point2>& path, double time) {
   path_ = path;
   closest_index_ = 0;
   recoveries_ = 0;
+  recoveries_without_motion_ = 0;
+  held_ = false;
   anchor_set_ = false;
   progress_time_ = time;
   best_remaining_ = kInfinity;
@@ -147,6 +149,12 @@ void PathFollower::updatePath(const std::vector<Point2>& path) {
 void PathFollower::stop() {
   path_.clear();
   state_ = FollowerState::kIdle;
+}
+
+void PathFollower::hold(double time) {
+  if (held_) return;
+  held_ = true;
+  held_since_ = time;
 }
 
 double PathFollower::remainingLength(const Pose2& pose) {
@@ -172,6 +180,13 @@ double PathFollower::remainingLength(const Pose2& pose) {
 }
 
 FollowerStep PathFollower::update(const Pose2& pose, const std::vector<Point2>& obstacles, double time) {
+  if (held_) {  // the held time does not count: timers move on by it, the stall watch starts afresh
+    const double pause = std::max(0.0, time - held_since_);
+    progress_time_ += pause;
+    recovery_until_ += pause;
+    anchor_set_ = false;
+    held_ = false;
+  }
   FollowerStep step;
   step.front_clearance = frontClearance(obstacles, options_);
   if (state_ == FollowerState::kIdle || state_ == FollowerState::kGoalReached || state_ == FollowerState::kFailed ||
@@ -214,6 +229,9 @@ FollowerStep PathFollower::update(const Pose2& pose, const std::vector<Point2>& 
     }
     state_ = FollowerState::kFollowing;
     anchor_set_ = false;
+    if (std::hypot(pose.x - recovery_start_pose_.x, pose.y - recovery_start_pose_.y) <= options_.stall_distance &&
+        std::abs(wrapAngle(pose.yaw - recovery_start_pose_.yaw)) <= options_.stall_angle)
+      ++recoveries_without_motion_;
   }
 
   // Stall watch: no motion for stall_timeout while following starts a recovery (or fails after too many).
@@ -228,6 +246,7 @@ FollowerStep PathFollower::update(const Pose2& pose, const std::vector<Point2>& 
       return step;
     }
     ++recoveries_;
+    recovery_start_pose_ = pose;
     // Turn towards the side with more room: the mean lateral position of nearby points tells the crowded side.
     double lateral = 0.0;
     for (const Point2& point : obstacles)

@@ -96,6 +96,7 @@ ExplorerOptions readExplorerOptions(const ros::NodeHandle& nh) {
   nh.param("search_angular_velocity", options.search_angular_velocity, options.search_angular_velocity);
   nh.param("scan_timeout", options.scan_timeout, options.scan_timeout);
   nh.param("pose_timeout", options.pose_timeout, options.pose_timeout);
+  nh.param("map_timeout", options.map_timeout, options.map_timeout);
   nh.param("obstacle_memory", options.obstacle_memory, options.obstacle_memory);
   if (options.map_frame.empty() || options.base_frame.empty())
     throw InputError("~map_frame, ~base_frame", "must not be empty");
@@ -104,6 +105,7 @@ ExplorerOptions readExplorerOptions(const ros::NodeHandle& nh) {
   for (const auto& [name, value] : {std::pair<const char*, double>{"replan_interval", options.replan_interval},
                                     {"goal_hysteresis", options.goal_hysteresis},
                                     {"blacklist_radius", options.blacklist_radius},
+                                    {"map_timeout", options.map_timeout},
                                     {"obstacle_memory", options.obstacle_memory}})
     if (!std::isfinite(value) || value < 0.0) throw InputError(std::string("~") + name, "must be zero or positive");
   for (const auto& [name, value] : {std::pair<const char*, double>{"scan_timeout", options.scan_timeout},
@@ -138,6 +140,7 @@ void Explorer::onMap(const nav_msgs::OccupancyGrid::ConstPtr& map) {
     return;
   }
   latest_map_ = map;
+  map_received_ = ros::Time::now();
   map_changed_ = true;
 }
 
@@ -183,6 +186,11 @@ bool Explorer::robotPose(Pose2* pose) {
   }
 }
 
+void Explorer::holdRobot(const ros::Time& now) {
+  follower_.hold(now.toSec());
+  publishCommand(VelocityCommand());
+}
+
 void Explorer::onTimer(const ros::TimerEvent&) {
   const ros::Time now = ros::Time::now();
   if (!latest_map_) {
@@ -191,15 +199,31 @@ void Explorer::onTimer(const ros::TimerEvent&) {
   }
   Pose2 pose;
   if (!robotPose(&pose)) {
-    publishCommand(VelocityCommand());
+    holdRobot(now);
     return;
   }
   if (last_pose_) distance_driven_ += std::hypot(pose.x - last_pose_->x, pose.y - last_pose_->y);
   last_pose_ = pose;
   if (!latest_scan_ || (now - latest_scan_->header.stamp).toSec() > options_.scan_timeout) {
     ROS_WARN_THROTTLE(5.0, "explorer: no recent scan on %s; stopped", scan_subscriber_.getTopic().c_str());
-    publishCommand(VelocityCommand());
+    holdRobot(now);
     return;
+  }
+  // The map stopped coming (the mapper died or hangs): stop until it comes again; the goal and the follower's
+  // state are kept (a map arrived at ROS time 0, before the clock, counts from the first tick).
+  if (map_received_.isZero()) map_received_ = now;
+  const double map_age = (now - map_received_).toSec();
+  if (options_.map_timeout > 0.0 && map_age > options_.map_timeout) {
+    if (!done_)
+      ROS_WARN_THROTTLE(5.0, "explorer: no new map on %s for %.1f s (mapper down?); stopped until one comes",
+                        map_subscriber_.getTopic().c_str(), map_age);
+    map_stale_ = true;
+    holdRobot(now);
+    return;
+  }
+  if (map_stale_) {
+    ROS_INFO("explorer: maps on %s again; exploring on", map_subscriber_.getTopic().c_str());
+    map_stale_ = false;
   }
 
   // The follower sees the latest scan and the remembered ones (placed with the robot's current pose).
@@ -223,9 +247,16 @@ void Explorer::onTimer(const ros::TimerEvent&) {
       return;
     }
     // A reached goal whose frontier is still there next time cannot be seen from there; a failed one cannot be
-    // reached: either way no goal near it again.
-    blacklist_.points.push_back(goal_->position);
-    if (step.state == FollowerState::kFailed)
+    // reached: either way no goal near it again. A goal failed because the robot could not move at all (no
+    // recovery moved it) is tried again when nothing else is left.
+    const bool robot_stuck = step.state == FollowerState::kFailed && follower_.recoveries() > 0 &&
+                             follower_.recoveriesWithoutMotion() == follower_.recoveries();
+    blacklist_.add(goal_->position, robot_stuck);
+    if (robot_stuck)
+      ROS_WARN("explorer: goal (%.2f, %.2f) failed: the robot did not move in %d recoveries (stuck?); "
+               "blacklisted until no other goal is left", goal_->position.x(), goal_->position.y(),
+               follower_.recoveries());
+    else if (step.state == FollowerState::kFailed)
       ROS_WARN("explorer: goal (%.2f, %.2f) not reached (%d recoveries, no progress); blacklisted",
                goal_->position.x(), goal_->position.y(), follower_.recoveries());
     goal_.reset();
@@ -264,8 +295,15 @@ void Explorer::plan(const Pose2& pose, const ros::Time& now) {
   }
   const std::optional<Point2> previous =
       goal_ && follower_.state() == FollowerState::kFollowing ? std::optional<Point2>(goal_->position) : std::nullopt;
-  const std::optional<FrontierGoal> goal =
+  std::optional<FrontierGoal> goal =
       nearestFrontierGoal(frontiers, planner_, blacklist_, options_.frontiers, previous, options_.goal_hysteresis);
+  if (!goal && !blacklist_.stuck_points.empty()) {
+    // Not done while the only goals left failed because the robot could not move: try them again (their
+    // recoveries are what may free the robot).
+    ROS_WARN("explorer: no other goal; %zu goals failed while the robot could not move: trying them again",
+             blacklist_.releaseStuck());
+    goal = nearestFrontierGoal(frontiers, planner_, blacklist_, options_.frontiers, previous, options_.goal_hysteresis);
+  }
   if (!goal) {
     goal_.reset();
     follower_.stop();

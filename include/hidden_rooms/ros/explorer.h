@@ -31,6 +31,7 @@ struct ExplorerOptions {
   double search_angular_velocity = 0.4;  // rad/s turned in place while there is no goal (and not done)
   double scan_timeout = 1.0;        // seconds (ROS time): an older scan stops the robot
   double pose_timeout = 1.0;        // seconds (ROS time): an older map -> base transform stops the robot
+  double map_timeout = 10.0;        // seconds (ROS time) without a new map (mapper down) stop the robot; 0 = never
   double obstacle_memory = 1.5;     // seconds (ROS time) laser points are remembered (for the robot's blind rear)
 };
 
@@ -39,7 +40,9 @@ ExplorerOptions readExplorerOptions(const ros::NodeHandle& private_nh);
 
 // Nearest-frontier exploration (replaces explore + move_base): frontiers of the latest `map`, the one nearest by
 // path cost as goal, a wavefront path to it, pure pursuit with a laser speed limit on `base_scan`, recovery and a
-// blacklist. Publishes `cmd_vel`, `exploration_markers` and the latched `exploration_done`.
+// blacklist. Publishes `cmd_vel`, `exploration_markers` and the latched `exploration_done`. Stops (and holds the
+// follower) while the map, the pose or the scan is stale; does not report done while goals failed only because
+// the robot could not move.
 class Explorer {
  public:
   // Subscribes and advertises; does not wait for anything (the control timer does the work).
@@ -52,6 +55,8 @@ class Explorer {
   void onScan(const sensor_msgs::LaserScan::ConstPtr& scan);
   void onTimer(const ros::TimerEvent& event);
   bool robotPose(Pose2* pose);
+  // Stops the robot from outside the follower (stale map, pose or scan): the follower's timers do not count it.
+  void holdRobot(const ros::Time& now);
   // Chooses a goal and a path from `pose`; sets done_ after done_confirmations plans without a goal.
   void plan(const Pose2& pose, const ros::Time& now);
   void setDone(bool done, const ros::Time& now);
@@ -65,6 +70,8 @@ class Explorer {
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;
   nav_msgs::OccupancyGrid::ConstPtr latest_map_;
+  ros::Time map_received_;  // ROS time the latest map arrived
+  bool map_stale_ = false;  // stopped because no map came for map_timeout
   bool map_changed_ = false;
   sensor_msgs::LaserScan::ConstPtr latest_scan_;
   std::vector<Point2> scan_points_;  // latest scan's returns in base_frame
