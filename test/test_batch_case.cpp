@@ -1,7 +1,10 @@
 // The batch analysis's cases (batch_case.h) and the batch_cases tool.
 #include <gtest/gtest.h>
 
+#include <chrono>
+#include <filesystem>
 #include <fstream>
+#include <thread>
 
 #include <opencv2/imgproc.hpp>
 
@@ -124,6 +127,52 @@ TEST(BatchCasesTool, PrintsOneJsonLinePerCaseAndFailsClearly) {
   result = testing::runCommand(kBatchCases + " " + dir + "/bad.xml --info 2>&1");
   EXPECT_EQ(result.exit_code, 2) << result.output;
   EXPECT_NE(result.output.find("bad.xml"), std::string::npos) << result.output;
+}
+
+// SIGKILL at times spread over a batch, each into the same --write-cases folder: every case file there is always
+// complete (equal to an uninterrupted run's), and a re-run completes the folder without any temporary left over.
+TEST(BatchCasesTool, SigkillLeavesNoPartialCaseFiles) {
+  const std::string dir = testing::makeTempDir("batch_cases_sigkill");
+  const auto read = [](const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  };
+  const auto run = [&](const std::string& out) {
+    return testing::startProcess({kBatchCases, std::string(HIDDEN_ROOMS_SOURCE_DIR) + "/worlds/medium_1.xml",
+                                  "--sequence", "1,2,3,4,5,6", "--methods", "unstructured", "--write-cases", out},
+                                 dir + "/log.txt");
+  };
+  const auto start = std::chrono::steady_clock::now();
+  ASSERT_EQ(testing::waitProcess(run(dir + "/reference")), 0) << read(dir + "/log.txt");
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const std::vector<std::string> files{"doors.yaml", "map.pgm", "map.yaml", "true_rooms.png"};
+
+  const std::string out = dir + "/out";
+  int killed = 0;
+  constexpr int kAttempts = 16;
+  for (int attempt = 0; attempt < kAttempts; ++attempt) {
+    const int pid = run(out);
+    std::this_thread::sleep_for(std::chrono::duration<double>(seconds * (attempt + 0.5) / kAttempts));
+    killed += testing::killProcess(pid);
+    if (!std::filesystem::is_directory(out)) continue;
+    for (const std::string& case_dir : testing::fileNames(out))
+      for (const std::string& name : testing::fileNames(out + "/" + case_dir)) {
+        if (name.find(".partial") != std::string::npos) continue;  // the killed writer's temporary
+        EXPECT_EQ(read(out + "/" + case_dir + "/" + name), read(dir + "/reference/" + case_dir + "/" + name))
+            << "attempt " << attempt << ": " << case_dir << "/" << name << " is not complete";
+      }
+  }
+  std::printf("%d of %d runs killed (run %.2f s)\n", killed, kAttempts, seconds);
+  EXPECT_GE(killed, kAttempts / 2) << "too few runs were still running when killed";
+
+  ASSERT_EQ(testing::waitProcess(run(out)), 0) << read(dir + "/log.txt");
+  ASSERT_EQ(testing::fileNames(out), testing::fileNames(dir + "/reference"));
+  for (const std::string& case_dir : testing::fileNames(out)) {
+    EXPECT_EQ(testing::fileNames(out + "/" + case_dir), files) << case_dir;  // no temporary left
+    for (const std::string& name : files)
+      EXPECT_EQ(read(out + "/" + case_dir + "/" + name), read(dir + "/reference/" + case_dir + "/" + name))
+          << case_dir << "/" << name;
+  }
 }
 
 }  // namespace

@@ -2,8 +2,11 @@
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
+#include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <thread>
 
 #include <opencv2/imgcodecs.hpp>
 
@@ -141,6 +144,71 @@ TEST(PredictRoomsOfflineTool, WritesRoomsCompletedMapAndMetrics) {
   ASSERT_EQ(metrics["rooms"].size(), 2u);
   EXPECT_GT(metrics["rooms"][0]["iou"].as<double>(), 0.9);
   EXPECT_DOUBLE_EQ(metrics["rooms"][1]["iou"].as<double>(), 0.0);
+}
+
+std::string readBytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+// rooms.yaml without its first lines (the computation time differs between runs).
+std::string roomsPart(const std::string& rooms_yaml) {
+  const size_t at = rooms_yaml.find("\nrooms:");
+  return at == std::string::npos ? rooms_yaml : rooms_yaml.substr(at);
+}
+
+// SIGKILL at times spread over a run, each into the same folder: every output there is always complete (equal to
+// an uninterrupted run's), and a re-run completes the folder without any temporary left over.
+TEST(PredictRoomsOfflineTool, SigkillLeavesNoPartialOutputAndTheRerunCompletes) {
+  const std::string dir = testing::makeTempDir("predict_tool_sigkill");
+  ASSERT_EQ(runCommand(kRender + " " + HIDDEN_ROOMS_SOURCE_DIR + "/worlds/large_2.xml --out " + dir +
+                       "/case --closed closable --hide-closed-rooms").exit_code, 0);
+  const std::vector<std::string> arguments{kPredict, "--map", dir + "/case/map.yaml", "--doors",
+                                           dir + "/case/doors.yaml", "--method", "default", "--gt-rooms",
+                                           dir + "/case/true_rooms.png", "--out"};
+  const auto run = [&](const std::string& out) {
+    std::vector<std::string> command = arguments;
+    command.push_back(out);
+    return testing::startProcess(command, dir + "/log.txt");
+  };
+  const auto start = std::chrono::steady_clock::now();
+  ASSERT_EQ(testing::waitProcess(run(dir + "/reference")), 0) << readBytes(dir + "/log.txt");
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const std::vector<std::string> outputs{"map.pgm", "map.yaml", "metrics.yaml", "overlay.png", "rooms.png", "rooms.yaml"};
+  ASSERT_EQ(testing::fileNames(dir + "/reference"), outputs);
+
+  const std::string out = dir + "/out";
+  int killed = 0, cut_while_writing = 0;
+  constexpr int kAttempts = 16;
+  for (int attempt = 0; attempt < kAttempts; ++attempt) {
+    const int pid = run(out);
+    std::this_thread::sleep_for(std::chrono::duration<double>(seconds * (attempt + 0.5) / kAttempts));
+    killed += testing::killProcess(pid);
+    if (!std::filesystem::is_directory(out)) continue;
+    int complete = 0;
+    for (const std::string& name : testing::fileNames(out)) {
+      if (name.find(".partial") != std::string::npos) continue;  // the killed writer's temporary
+      ASSERT_NE(std::find(outputs.begin(), outputs.end(), name), outputs.end()) << name;
+      const std::string expected = readBytes(dir + "/reference/" + name), written = readBytes(out + "/" + name);
+      if (name == "rooms.yaml") {
+        EXPECT_EQ(roomsPart(written), roomsPart(expected)) << "attempt " << attempt << ": " << name;
+      } else {
+        EXPECT_EQ(written, expected) << "attempt " << attempt << ": " << name << " is not complete";
+      }
+      ++complete;
+    }
+    cut_while_writing += complete > 0 && complete < static_cast<int>(outputs.size());
+  }
+  std::printf("%d of %d runs killed (run %.2f s), %d with some outputs written\n", killed, kAttempts, seconds,
+              cut_while_writing);
+  EXPECT_GE(killed, kAttempts / 2) << "too few runs were still running when killed";
+
+  ASSERT_EQ(testing::waitProcess(run(out)), 0) << readBytes(dir + "/log.txt");
+  EXPECT_EQ(testing::fileNames(out), outputs);  // no temporary left
+  for (const std::string& name : outputs) {
+    if (name == "rooms.yaml") continue;
+    EXPECT_EQ(readBytes(out + "/" + name), readBytes(dir + "/reference/" + name)) << name;
+  }
 }
 
 TEST(PredictRoomsOfflineTool, ScoresABenchmarkCase) {

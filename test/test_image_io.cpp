@@ -1,3 +1,6 @@
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -140,6 +143,25 @@ TEST(FileIo, WritesAtomicallyAndLeavesNoPartialFile) {
   EXPECT_THROW(writeImage(dir + "/bad.png", cv::Mat(2, 2, CV_32FC1, cv::Scalar(0))), InputError);
   EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir), std::filesystem::directory_iterator()), 1);
   EXPECT_THROW(writeTextAtomically(dir + "/no/such/folder/x.txt", "x", "test file"), InputError);
+}
+
+TEST(FileIo, RemovesTheTemporariesOfKilledWriters) {
+  const std::string dir = testing::makeTempDir("stale_temporaries");
+  const std::string path = dir + "/map.pgm";
+  // A writer that is gone (a child that exited, reaped) and one that still runs (this test's parent).
+  const pid_t child = fork();
+  if (child == 0) _exit(0);
+  ASSERT_GT(child, 0);
+  ASSERT_EQ(waitpid(child, nullptr, 0), child);
+  const std::string dead = path + ".partial" + std::to_string(child);
+  const std::string alive = path + ".partial" + std::to_string(getppid());
+  const std::string other = dir + "/map.yaml.partial" + std::to_string(child);  // another target's
+  for (const std::string& file : {dead, alive, other}) std::ofstream(file) << "half";
+  writeTextAtomically(path, "P5\n", "test file");
+  EXPECT_EQ(readTextFile(path, "test file"), "P5\n");
+  EXPECT_FALSE(std::filesystem::exists(dead));
+  EXPECT_TRUE(std::filesystem::exists(alive));
+  EXPECT_TRUE(std::filesystem::exists(other));
 }
 
 }  // namespace

@@ -1,8 +1,11 @@
 // map_from_bag on a short bag recorded from the core simulation (record_simulation_bag): the map against the
 // rendered ground truth, the same map for the same bag and seed, and clear errors on bad input.
+#include <chrono>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <thread>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <nav_msgs/Odometry.h>
@@ -57,15 +60,33 @@ TEST_F(MapFromBag, MapsTheShortBagWithinThresholds) {
   EXPECT_GE(figure(readFile(dir_ + "/metrics.yaml"), "free_iou"), 0.85);
 }
 
-TEST_F(MapFromBag, SameBagAndSeedGiveTheSameMap) {
-  for (const char* name : {"s1", "s2"}) {
-    const auto result = testing::runCommand(std::string(MAP_FROM_BAG_BIN) + " " + dir_ + "/run.bag --quiet --seed 5 --out " +
-                                            dir_ + "/" + name);
-    ASSERT_EQ(result.exit_code, 0) << result.output;
-  }
-  EXPECT_EQ(readFile(dir_ + "/s1.pgm"), readFile(dir_ + "/s2.pgm"));
+// The same bag and seed give the same map, also when a run was killed with SIGKILL mid-way and run again: the
+// killed run leaves no output (the files are written at the end, each through a temporary file renamed into
+// place), and the temporary a kill during a write would leave is removed by the re-run.
+TEST_F(MapFromBag, SameBagAndSeedGiveTheSameMapAlsoAfterASigkill) {
+  const std::string tool = MAP_FROM_BAG_BIN;
+  auto result = testing::runCommand(tool + " " + dir_ + "/run.bag --quiet --seed 5 --out " + dir_ + "/s1");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+
+  // Killed once its progress line shows (mapping under way, about a tenth of the bag).
+  const std::string killed_dir = testing::makeTempDir("map_from_bag_killed");
+  const int pid = testing::startProcess({tool, dir_ + "/run.bag", "--seed", "5", "--out", killed_dir + "/s2"},
+                                        dir_ + "/killed.log");
+  ASSERT_GT(pid, 0);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (readFile(dir_ + "/killed.log").find("% ") == std::string::npos && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  ASSERT_TRUE(testing::killProcess(pid)) << "map_from_bag ended before it was killed:\n" << readFile(dir_ + "/killed.log");
+  EXPECT_TRUE(testing::fileNames(killed_dir).empty()) << "the killed run left files";
+
+  // What a kill during a write leaves: a temporary of a writer that no longer runs.
+  std::ofstream(killed_dir + "/s2.pgm.partial" + std::to_string(pid)) << "P5\n";
+  result = testing::runCommand(tool + " " + dir_ + "/run.bag --quiet --seed 5 --out " + killed_dir + "/s2");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_EQ(testing::fileNames(killed_dir), (std::vector<std::string>{"s2.pgm", "s2.yaml"}));
+  EXPECT_EQ(readFile(dir_ + "/s1.pgm"), readFile(killed_dir + "/s2.pgm"));
   EXPECT_EQ(readFile(dir_ + "/s1.yaml").substr(readFile(dir_ + "/s1.yaml").find("resolution")),
-            readFile(dir_ + "/s2.yaml").substr(readFile(dir_ + "/s2.yaml").find("resolution")));
+            readFile(killed_dir + "/s2.yaml").substr(readFile(killed_dir + "/s2.yaml").find("resolution")));
 }
 
 TEST_F(MapFromBag, BadInputGivesAClearErrorAndExitCode2) {

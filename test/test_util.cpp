@@ -11,7 +11,10 @@
 #include "hidden_rooms/render.h"
 #include "hidden_rooms/room_predictor.h"
 
+#include <fcntl.h>
+#include <signal.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <cstdio>
 
@@ -23,6 +26,45 @@ namespace hidden_rooms::testing {
 }  // namespace hidden_rooms::testing
 
 namespace hidden_rooms::testing {
+
+int startProcess(const std::vector<std::string>& arguments, const std::string& log_path) {
+  std::vector<char*> argv;
+  for (const std::string& argument : arguments) argv.push_back(const_cast<char*>(argument.c_str()));
+  argv.push_back(nullptr);
+  const pid_t pid = fork();
+  if (pid == 0) {
+    const int log = open(log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (log >= 0) {
+      dup2(log, STDOUT_FILENO);
+      dup2(log, STDERR_FILENO);
+      close(log);
+    }
+    execv(argv[0], argv.data());
+    _exit(127);
+  }
+  return pid;
+}
+
+bool killProcess(int pid) {
+  int status = 0;
+  if (waitpid(pid, &status, WNOHANG) != 0) return false;  // it exited already (and is reaped now)
+  kill(pid, SIGKILL);  // a child that exits meanwhile stays a zombie until reaped: its pid is still its own
+  waitpid(pid, &status, 0);
+  return WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL;
+}
+
+int waitProcess(int pid) {
+  int status = 0;
+  if (waitpid(pid, &status, 0) != pid) return -1;
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+std::vector<std::string> fileNames(const std::string& dir) {
+  std::vector<std::string> names;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) names.push_back(entry.path().filename().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
 
 CommandResult runCommand(const std::string& command) {
   CommandResult result;

@@ -67,6 +67,15 @@ struct CommandResult {
 // Runs a shell command and captures its output and exit code.
 CommandResult runCommand(const std::string& command);
 
+// Starts `arguments` (the program first, no shell) with stdout and stderr going to `log_path`; the child's pid.
+int startProcess(const std::vector<std::string>& arguments, const std::string& log_path);
+// SIGKILLs the child `pid` and reaps it; true when it was still running then (it died of the signal).
+bool killProcess(int pid);
+// Waits for the child `pid`; its exit code, -1 when it died of a signal.
+int waitProcess(int pid);
+// The names of the files in `dir` (not recursive), sorted.
+std::vector<std::string> fileNames(const std::string& dir);
+
 // A tiny environment in the thesis schema (0.05 m per pixel): a 10 m x 2 m corridor (pixels x 0..200,
 // y 0..40) under two rooms, A (x 0..80, y 40..120) and B (x 80..200, y 40..120), each with one door to the
 // corridor (door 1 at (40, 40) into A, door 2 at (140, 40) into B). `extra_portal` adds a PORTAL segment at a

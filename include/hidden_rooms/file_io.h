@@ -15,7 +15,8 @@ YAML::Node loadYamlFile(const std::string& path, const std::string& what);
 
 // Writes `path` so that no reader (and no killed run) ever leaves a partial file there: `write` fills a temporary
 // file beside it, which then replaces `path` in one rename. When `write` throws or the rename fails, the
-// temporary file is removed and the error propagates (InputError naming `path` for the rename).
+// temporary file is removed and the error propagates (InputError naming `path` for the rename). The temporary
+// is PATH.partialPID; those of writers that no longer run (killed during a write) are removed first.
 void writeAtomically(const std::string& path, const std::function<void(const std::string& temporary_path)>& write);
 // The same for a text: InputError(path, "cannot write <what>") when it cannot be written.
 void writeTextAtomically(const std::string& path, const std::string& text, const std::string& what);

@@ -509,10 +509,7 @@ std::string environmentToXml(const Environment& environment) {
 }
 
 void saveEnvironment(const Environment& environment, const std::string& path) {
-  std::ofstream file(path, std::ios::binary);
-  if (!file) throw InputError(path, "cannot write environment file");
-  file << environmentToXml(environment);
-  if (!file) throw InputError(path, "write failed");
+  writeTextAtomically(path, environmentToXml(environment), "environment file");
 }
 
 std::vector<int> closableDoors(const Environment& environment) {

@@ -1,7 +1,9 @@
 #include "hidden_rooms/file_io.h"
 
+#include <signal.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -28,9 +30,37 @@ YAML::Node loadYamlFile(const std::string& path, const std::string& what) {
   }
 }
 
+namespace {
+
+constexpr const char* kTemporarySuffix = ".partial";
+
+// Removes the temporaries of `path` (PATH.partialPID) whose writer no longer runs: a writer killed during the
+// write leaves one behind.
+void removeStaleTemporaries(const std::string& path) {
+  namespace fs = std::filesystem;
+  const fs::path target(path);
+  const fs::path folder = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  const std::string prefix = target.filename().string() + kTemporarySuffix;
+  std::error_code error;
+  for (fs::directory_iterator entry(folder, error), end; !error && entry != end; entry.increment(error)) {
+    const std::string name = entry->path().filename().string();
+    if (name.size() <= prefix.size() || name.compare(0, prefix.size(), prefix) != 0) continue;
+    const std::string digits = name.substr(prefix.size());
+    if (digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos) continue;
+    const pid_t writer = static_cast<pid_t>(std::stol(digits));
+    if (writer > 0 && kill(writer, 0) == -1 && errno == ESRCH) {
+      std::error_code ignored;
+      fs::remove(entry->path(), ignored);
+    }
+  }
+}
+
+}  // namespace
+
 void writeAtomically(const std::string& path, const std::function<void(const std::string& temporary_path)>& write) {
+  removeStaleTemporaries(path);
   // Unique per process, in the target's folder (a rename within one file system is atomic).
-  const std::string temporary = path + ".partial" + std::to_string(getpid());
+  const std::string temporary = path + kTemporarySuffix + std::to_string(getpid());
   std::error_code ignored;
   try {
     write(temporary);

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <deque>
-#include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -20,6 +20,7 @@
 
 #include "hidden_rooms/command_line.h"
 #include "hidden_rooms/environment.h"
+#include "hidden_rooms/file_io.h"
 #include "hidden_rooms/image_io.h"
 #include "hidden_rooms/input_error.h"
 #include "hidden_rooms/map_quality.h"
@@ -135,12 +136,17 @@ int run(int argc, char** argv) {
   std::vector<double> scan_times;
   std::vector<Pose2> estimate;
   std::vector<std::pair<double, hidden_rooms::RangeScan>> inserted_scans;  // for the observed cells
-  int processed = 0, dropped = 0, received = 0;
+  int processed = 0, dropped = 0, received = 0, without_returns = 0;
   std::string last_tf_error;
   const Clock::time_point start = Clock::now();
   Clock::time_point last_progress = start;
 
   auto process = [&](const sensor_msgs::LaserScan& scan) {
+    if (hidden_rooms::countValidRanges(scan) == 0) {  // as the mapper node: nothing to match or insert
+      ++dropped;
+      ++without_returns;
+      return;
+    }
     try {
       const Pose2 odometry =
           hidden_rooms::fromRos(tf_buffer.lookupTransform(odom_frame, base_frame, scan.header.stamp).transform);
@@ -192,8 +198,9 @@ int run(int argc, char** argv) {
   if (!quiet) std::fprintf(stderr, "\n");
   if (processed == 0)
     throw InputError(bag_path, received == 0 ? "no scans on topic " + scan_topic
-                                             : "no scan has odometry (" + odom_frame + " -> " + base_frame +
-                                                   " in /tf) at its stamp: " + last_tf_error);
+                               : without_returns == received ? "no scan has a valid range"
+                                                             : "no scan has odometry (" + odom_frame + " -> " +
+                                                                   base_frame + " in /tf) at its stamp: " + last_tf_error);
 
   const hidden_rooms::OccupancyGrid map = mapper.map();
   const std::string yaml = hidden_rooms::saveMap(map, prefix);
@@ -226,11 +233,11 @@ int run(int argc, char** argv) {
                 trajectory.position_max, trajectory.yaw_rmse);
   std::printf("%s", text);
   if (!metrics_path.empty()) {
-    std::ofstream out(metrics_path);
+    std::ostringstream out;
     out << "bag: " << bag_path << "\nbag_seconds: " << bag_seconds << "\nwall_seconds: " << wall_seconds
         << "\nspeed_factor: " << bag_seconds / std::max(wall_seconds, 1e-9) << "\nscans: " << processed
         << "\nscans_inserted: " << mapper.scansInserted() << "\n" << text;
-    if (!out) throw InputError(metrics_path, "cannot write");
+    hidden_rooms::writeTextAtomically(metrics_path, out.str(), "metrics file");
   }
   return hidden_rooms::kExitOk;
 }

@@ -7,11 +7,13 @@
 #include <iomanip>
 #include <iostream>
 #include <limits>
+#include <sstream>
 
 #include <opencv2/imgproc.hpp>
 
 #include "hidden_rooms/command_line.h"
 #include "hidden_rooms/door_translation.h"
+#include "hidden_rooms/file_io.h"
 #include "hidden_rooms/input_error.h"
 #include "hidden_rooms/map_quality.h"
 #include "hidden_rooms/range_scan.h"
@@ -101,7 +103,7 @@ int run(int argc, char** argv) {
   const double coverage =
       quality.true_free_cells ? double(quality.intersection_cells) / double(quality.true_free_cells) : 0.0;
   const cv::Mat1f wall_distance = distanceToOccupied(map);
-  std::ofstream report((out / "exploration.yaml").string());
+  std::ostringstream report;
   report << std::fixed << std::setprecision(4);
   report << "# translate_doors: the run against its world (world frame = the environment's)\n"
          << "world_from_map: [" << world_from_map.x << ", " << world_from_map.y << ", " << world_from_map.yaw << "]\n"
@@ -129,7 +131,7 @@ int run(int argc, char** argv) {
            << "], error: " << error << ", global_error: " << global_error << ", to_mapped_wall: " << (std::isfinite(to_wall) ? std::to_string(to_wall) : std::string(".inf"))
            << "}\n";
   }
-  if (!report) throw InputError((out / "exploration.yaml").string(), "cannot be written");
+  writeTextAtomically((out / "exploration.yaml").string(), report.str(), "exploration report");
   std::cout << "translate_doors: coverage " << std::fixed << std::setprecision(3)
             << coverage
             << ", free IoU " << quality.free_iou << ", worst door error " << worst_error << " m -> "
