@@ -1,11 +1,15 @@
 // Pose logs, the door translation of METHOD.md §2, trajectory alignment and the truth moved into a map's grid.
 #include <cmath>
+#include <fstream>
+#include <limits>
 
 #include <gtest/gtest.h>
 
 #include "hidden_rooms/door_translation.h"
 #include "hidden_rooms/input_error.h"
+#include "hidden_rooms/pose_log.h"
 #include "hidden_rooms/range_scan.h"
+#include "test_util.h"
 
 namespace hidden_rooms {
 namespace {
@@ -50,6 +54,27 @@ TEST(PoseLog, RejectsBadLogsNamingTheLine) {
   EXPECT_NE(problem("0.0 nan 2 3\n").find("line 1"), std::string::npos);
   EXPECT_NE(problem("0.2 1 2 3\n0.1 1 2 3\n").find("does not increase"), std::string::npos);
   EXPECT_THROW(loadPoseLog("/nonexistent/poses.log"), InputError);
+}
+
+TEST(PoseLog, PreparesAKilledLoggersLogForAppending) {
+  const std::string dir = testing::makeTempDir("pose_log_append");
+  const std::string path = dir + "/poses.log";
+  EXPECT_EQ(preparePoseLogForAppend(path), -std::numeric_limits<double>::infinity());  // missing
+  std::ofstream(path) << poseLogHeader("map", "base_link");
+  EXPECT_EQ(preparePoseLogForAppend(path), -std::numeric_limits<double>::infinity());  // no pose yet
+  // Killed while writing its third line.
+  const std::string complete = poseLogHeader("map", "base_link") + poseLogLine({1.0, {1.5, -2.0, 0.25}}) +
+                               poseLogLine({1.1, {1.6, -2.0, 0.3}});
+  std::ofstream(path, std::ios::trunc) << complete << "1.2000 1.70";
+  EXPECT_DOUBLE_EQ(preparePoseLogForAppend(path), 1.1);
+  std::ofstream(path, std::ios::app) << poseLogLine({1.2, {1.7, -2.0, 0.35}});
+  const PoseLog continued = loadPoseLog(path);
+  ASSERT_EQ(continued.poses.size(), 3u);
+  EXPECT_DOUBLE_EQ(continued.poses[2].pose.x, 1.7);
+  EXPECT_EQ(continued.parent_frame, "map");
+  // Something else than a pose log is not continued.
+  std::ofstream(path, std::ios::trunc) << "not a pose log\n";
+  EXPECT_THROW(preparePoseLogForAppend(path), InputError);
 }
 
 TEST(PoseLog, InterpolatesPosesAndYawAcrossPi) {

@@ -1,6 +1,8 @@
 // rostest: pose_logger (test/pose_logger.test) logs tf map -> base_link and the simulator's true pose every 0.1 s
 // of simulated time, in the pose-log format the door translation reads.
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <string>
 
 #include <geometry_msgs/Twist.h>
@@ -8,7 +10,9 @@
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
 
+#include "hidden_rooms/file_io.h"
 #include "hidden_rooms/pose_log.h"
+#include "hidden_rooms/ros/pose_logger.h"
 
 namespace {
 
@@ -58,6 +62,62 @@ TEST(PoseLogger, LogsTheEstimateAndTheTruthEveryPeriod) {
   };
   EXPECT_NEAR(displacement(ground_truth), 1.5, 0.3);
   EXPECT_NEAR(displacement(estimate), displacement(ground_truth), 0.1);
+}
+
+// Spins until `seconds` more of simulated time have passed (or 30 s of wall time).
+void spinSimulated(double seconds) {
+  const ros::Time until = ros::Time::now() + ros::Duration(seconds);
+  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(30.0);
+  while (ros::Time::now() < until && ros::WallTime::now() < deadline) {
+    ros::spinOnce();
+    ros::WallDuration(0.005).sleep();
+  }
+}
+
+int headerCount(const std::string& path) {
+  const std::string text = hidden_rooms::readTextFile(path, "log");
+  int count = 0;
+  for (size_t at = text.find("# frame:"); at != std::string::npos; at = text.find("# frame:", at + 1)) ++count;
+  return count;
+}
+
+// A respawned logger (exploration_run.launch) continues its logs: run in this process twice with `append`, the
+// first run's last lines cut as a kill during a write leaves them.
+TEST(PoseLogger, ARestartedLoggerContinuesItsLogs) {
+  std::string log_dir;
+  ASSERT_TRUE(ros::NodeHandle().getParam("log_dir", log_dir));
+  hidden_rooms::PoseLoggerOptions options;
+  options.estimate_log = log_dir + "/restart/poses_map.log";
+  options.ground_truth_log = log_dir + "/restart/poses_truth.log";
+  options.append = true;
+  std::filesystem::remove_all(log_dir + "/restart");
+  ASSERT_GT(ros::Time::now().toSec(), 0.0) << "no simulated time";
+  {
+    hidden_rooms::PoseLogger logger(ros::NodeHandle(), options);
+    spinSimulated(4.0);
+    ASSERT_GT(logger.estimatesLogged(), 5);
+    ASSERT_GT(logger.groundTruthLogged(), 5);
+  }
+  for (const std::string& path : {options.estimate_log, options.ground_truth_log})
+    std::ofstream(path, std::ios::app) << "99999.0000 1.2";  // cut by the kill
+  const double restart = ros::Time::now().toSec();
+  spinSimulated(1.0);  // the respawn delay
+  {
+    hidden_rooms::PoseLogger logger(ros::NodeHandle(), options);
+    spinSimulated(4.0);
+    ASSERT_GT(logger.estimatesLogged(), 5);
+  }
+  for (const std::string& path : {options.estimate_log, options.ground_truth_log}) {
+    hidden_rooms::PoseLog log;
+    ASSERT_NO_THROW(log = hidden_rooms::loadPoseLog(path)) << path;  // times increase, no cut line
+    EXPECT_EQ(headerCount(path), 1) << path;
+    ASSERT_GE(log.poses.size(), 20u) << path;
+    size_t before = 0, after = 0;
+    for (const hidden_rooms::TimedPose& pose : log.poses) (pose.time < restart ? before : after) += 1;
+    EXPECT_GE(before, 10u) << path << ": the first run's poses";
+    EXPECT_GE(after, 10u) << path << ": the second run's poses";
+  }
+  EXPECT_EQ(hidden_rooms::loadPoseLog(options.ground_truth_log).parent_frame, "world");
 }
 
 }  // namespace

@@ -27,6 +27,11 @@ struct PoseLog {
 PoseLog loadPoseLog(const std::string& path);
 PoseLog parsePoseLog(const std::string& text, const std::string& source_name);
 
+// Prepares the log at `path` to be continued by a restarted pose_logger: a last line cut by a kill (no newline at
+// its end) is removed from the file. Returns the time of its last pose; -infinity when the file is missing or
+// holds no pose yet. Throws InputError naming the file when its complete lines are no pose log.
+double preparePoseLogForAppend(const std::string& path);
+
 // The header line pose_logger writes first, and one pose line (with its newline).
 std::string poseLogHeader(const std::string& parent_frame, const std::string& child_frame);
 std::string poseLogLine(const TimedPose& pose);

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <iomanip>
+#include <limits>
 #include <sstream>
 
 #include "hidden_rooms/file_io.h"
@@ -60,6 +62,28 @@ PoseLog parsePoseLog(const std::string& text, const std::string& source_name) {
 }
 
 PoseLog loadPoseLog(const std::string& path) { return parsePoseLog(readTextFile(path, "pose log"), path); }
+
+double preparePoseLogForAppend(const std::string& path) {
+  constexpr double kNoPose = -std::numeric_limits<double>::infinity();
+  std::error_code error;
+  if (!std::filesystem::exists(path, error)) return kNoPose;
+  std::string text = readTextFile(path, "pose log");
+  const size_t complete = text.empty() || text.back() == '\n' ? text.size() : text.rfind('\n') + 1;  // npos + 1 = 0
+  if (complete < text.size()) {
+    std::filesystem::resize_file(path, complete, error);
+    if (error) throw InputError(path, "cannot cut the unfinished last line: " + error.message());
+    text.resize(complete);
+  }
+  // Lines that are not comments or blank make a pose log, which must parse.
+  std::istringstream lines(text);
+  std::string line;
+  bool has_pose = false;
+  while (!has_pose && std::getline(lines, line)) {
+    const size_t first = line.find_first_not_of(" \t\r");
+    has_pose = first != std::string::npos && line[first] != '#';
+  }
+  return has_pose ? parsePoseLog(text, path).poses.back().time : kNoPose;
+}
 
 std::string poseLogHeader(const std::string& parent_frame, const std::string& child_frame) {
   return "# frame: " + parent_frame + " -> " + child_frame + "\n# time x y yaw (s, m, m, rad)\n";

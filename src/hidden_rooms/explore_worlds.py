@@ -161,6 +161,10 @@ def explore(args, out_dir, log):
     """Runs the launch until a stop criterion; returns (status, simulated seconds). Maps go to out_dir."""
     maps_dir = os.path.join(out_dir, "maps")
     os.makedirs(maps_dir, exist_ok=True)
+    # The pose_logger continues existing logs (it is respawned with append): those of an earlier, unfinished run go.
+    for name in ("poses_map.log", "poses_truth.log"):
+        if os.path.exists(os.path.join(out_dir, name)):
+            os.remove(os.path.join(out_dir, name))
     command = ["roslaunch", "-p", os.environ["ROS_MASTER_URI"].rsplit(":", 1)[1], "hidden_rooms",
                "exploration_run.launch", "world:=%s" % args.world, "out_dir:=%s" % out_dir,
                "closed_doors:=%s" % args.closed, "realtime_factor:=%g" % args.realtime_factor,

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <limits>
 
 #include <tf2/exceptions.h>
 
@@ -15,13 +16,21 @@ namespace {
 
 constexpr double kGiveUpDelay = 1.0;  // seconds of ROS time after which a pose tf cannot give is skipped
 
-// Opens a log for writing, creating its folder; throws InputError when that fails.
-void openLog(const std::string& path, std::ofstream* log) {
+// Opens a log for writing (appending: after its last complete line), creating its folder; returns the time of
+// the last pose already in it (-infinity: none). Throws InputError when that fails.
+double openLog(const std::string& path, bool append, std::ofstream* log) {
   const std::filesystem::path folder = std::filesystem::path(path).parent_path();
   std::error_code error;
   if (!folder.empty()) std::filesystem::create_directories(folder, error);
-  log->open(path, std::ios::out | std::ios::trunc);
+  const double last_time = append ? preparePoseLogForAppend(path) : -std::numeric_limits<double>::infinity();
+  log->open(path, std::ios::out | (append ? std::ios::app : std::ios::trunc));
   if (!*log) throw InputError(path, "cannot be written (pose log)");
+  return last_time;
+}
+
+bool emptyFile(const std::string& path) {
+  std::error_code error;
+  return std::filesystem::file_size(path, error) == 0 || error;
 }
 
 }  // namespace
@@ -34,6 +43,7 @@ PoseLoggerOptions readPoseLoggerOptions(const ros::NodeHandle& private_nh) {
   private_nh.param("base_frame", options.base_frame, options.base_frame);
   private_nh.param("ground_truth_topic", options.ground_truth_topic, options.ground_truth_topic);
   private_nh.param("period", options.period, options.period);
+  private_nh.param("append", options.append, options.append);
   if (!std::isfinite(options.period) || options.period <= 0.0) throw InputError("~period", "must be positive");
   if (options.estimate_log.empty()) throw InputError("~estimate_log", "must name a file");
   if (options.map_frame.empty() || options.base_frame.empty())
@@ -43,11 +53,13 @@ PoseLoggerOptions readPoseLoggerOptions(const ros::NodeHandle& private_nh) {
 
 PoseLogger::PoseLogger(ros::NodeHandle nh, const PoseLoggerOptions& options)
     : options_(options), tf_buffer_(ros::Duration(10.0)), tf_listener_(tf_buffer_) {
-  openLog(options.estimate_log, &estimate_log_);
-  estimate_log_ << poseLogHeader(options.map_frame, options.base_frame) << std::flush;
+  last_estimate_time_ = openLog(options.estimate_log, options.append, &estimate_log_);
+  if (emptyFile(options.estimate_log))
+    estimate_log_ << poseLogHeader(options.map_frame, options.base_frame) << std::flush;
   if (!options.ground_truth_log.empty()) {
     // Its frames are written with the first message (its header names the world frame).
-    openLog(options.ground_truth_log, &ground_truth_log_);
+    last_ground_truth_time_ = openLog(options.ground_truth_log, options.append, &ground_truth_log_);
+    ground_truth_header_written_ = !emptyFile(options.ground_truth_log);
     ground_truth_subscriber_ = nh.subscribe(options.ground_truth_topic, 100, &PoseLogger::onGroundTruth, this);
   }
   timer_ = nh.createTimer(ros::Duration(options.period), &PoseLogger::onTimer, this);
@@ -60,7 +72,14 @@ void PoseLogger::onTimer(const ros::TimerEvent&) {
   const double now = ros::Time::now().toSec();
   if (now <= 0.0) return;
   if (next_estimate_time_ <= 0.0) next_estimate_time_ = std::ceil(now / options_.period) * options_.period;
+  if (last_estimate_time_ > now)
+    ROS_WARN_ONCE("pose_logger: the continued log %s ends at %.2f s, after the ROS time now (%.2f s; a log of another "
+                  "run?): poses are logged from then on", options_.estimate_log.c_str(), last_estimate_time_, now);
   while (next_estimate_time_ <= now) {
+    if (next_estimate_time_ <= last_estimate_time_ + 1e-6) {  // already in the continued log
+      next_estimate_time_ += options_.period;
+      continue;
+    }
     const ros::Time wanted(next_estimate_time_);
     std::string problem;
     if (tf_buffer_.canTransform(options_.map_frame, options_.base_frame, wanted, &problem)) {
@@ -87,8 +106,11 @@ void PoseLogger::onGroundTruth(const nav_msgs::Odometry::ConstPtr& message) {
     ROS_WARN_THROTTLE(10.0, "pose_logger: ground-truth pose with a non-finite value dropped");
     return;
   }
-  if (ground_truth_logged_ == 0)
+  if (stamp.toSec() <= last_ground_truth_time_ + 1e-6) return;  // already in the continued log
+  if (!ground_truth_header_written_) {
     ground_truth_log_ << poseLogHeader(message->header.frame_id, message->child_frame_id + " (ground truth)");
+    ground_truth_header_written_ = true;
+  }
   last_ground_truth_stamp_ = stamp;
   ground_truth_log_ << poseLogLine({stamp.toSec(), pose}) << std::flush;
   ++ground_truth_logged_;

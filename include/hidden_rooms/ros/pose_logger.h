@@ -1,6 +1,7 @@
 #pragma once
 
 #include <fstream>
+#include <limits>
 #include <string>
 
 #include <nav_msgs/Odometry.h>
@@ -18,6 +19,9 @@ struct PoseLoggerOptions {
   std::string base_frame = "base_link";
   std::string ground_truth_topic = "base_pose_ground_truth";
   double period = 0.1;                          // seconds of ROS time between logged poses
+  // Continue existing logs (a respawned logger) instead of starting them afresh: a line cut by a kill is
+  // removed, poses at or before a log's last time are not logged again.
+  bool append = false;
 };
 
 // Reads the options from the private node handle; throws InputError for a bad value.
@@ -25,7 +29,8 @@ PoseLoggerOptions readPoseLoggerOptions(const ros::NodeHandle& private_nh);
 
 // The thesis's tf listener: logs the robot's pose in the map (tf map -> base_link) at every multiple of `period`
 // of ROS time and, optionally, its true pose (nav_msgs/Odometry on base_pose_ground_truth) every `period`, into
-// pose logs (pose_log.h) flushed line by line so a killed run keeps what it logged.
+// pose logs (pose_log.h) flushed line by line so a killed run keeps what it logged; with `append` a restarted
+// logger continues them.
 class PoseLogger {
  public:
   // Opens the logs (throws InputError when one cannot be written); does not wait for tf or messages.
@@ -47,6 +52,10 @@ class PoseLogger {
   ros::Timer timer_;
   double next_estimate_time_ = 0.0;  // next grid time to log (seconds); 0 = not started
   ros::Time last_ground_truth_stamp_;
+  // The last pose already in a continued log (seconds); -infinity for a new log.
+  double last_estimate_time_ = -std::numeric_limits<double>::infinity();
+  double last_ground_truth_time_ = -std::numeric_limits<double>::infinity();
+  bool ground_truth_header_written_ = false;
   long long estimates_logged_ = 0;
   long long ground_truth_logged_ = 0;
 };
