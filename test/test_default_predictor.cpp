@@ -222,6 +222,30 @@ TEST(DefaultPredictor, NicheSideWallsAreNotStubs) {
   EXPECT_GT(scoreOf(s, makeRoomPredictor("default")->predict(s.request)).iou[0], 0.9);
 }
 
+// A block of unknown between a north corridor and a west corridor, bounded by known space to the south and
+// east: a room behind a door in the north corridor, and below it a long room behind a door in the west corridor
+// (their shared wall unseen). Stubs in the corridors mark where the rooms' walls meet the corridors. Both
+// rectangles reach across the whole block; the overlap belongs to the west door, which opens right into it.
+TEST(DefaultPredictor, OverlapOfPerpendicularDoorsGoesToTheNearerDoor) {
+  const cv::Size size(260, 260);
+  cv::Mat1b states(size, 2);
+  states(cv::Rect(5, 5, 250, 40)).setTo(1);     // north corridor, rows 5..44
+  states(cv::Rect(5, 5, 40, 250)).setTo(1);     // west corridor, columns 5..44
+  states(cv::Rect(48, 48, 172, 172)).setTo(0);  // the unknown block, rows and columns 48..219
+  states(cv::Rect(48, 223, 207, 32)).setTo(1);  // explored space south of the block
+  states(cv::Rect(223, 48, 32, 207)).setTo(1);  // and east of it
+  states(cv::Rect(110, 37, 6, 8)).setTo(2);     // stub in the north corridor at the rooms' west wall
+  states(cv::Rect(37, 130, 8, 6)).setTo(2);     // stub in the west corridor at the rooms' shared wall
+  cv::Mat1w truth = cv::Mat1w::zeros(size);
+  truth(cv::Rect(113, 48, 107, 85)).setTo(1);   // behind the north door: rows 48..132
+  truth(cv::Rect(48, 133, 172, 87)).setTo(2);   // behind the west door: rows 133..219, the block's width
+  Synthetic s = syntheticFromStates(states, truth, {{165, 46}, {46, 190}});
+  s.request.doors.doors[1].orientation = DoorOrientation::kAlongY;
+  s.request.parameters["default_grown_area_ratio"] = 1000.0;  // the wall-fitted rectangles only
+  const RoomScores scores = scoreOf(s, makeRoomPredictor("default")->predict(s.request));
+  for (size_t k = 0; k < scores.iou.size(); ++k) EXPECT_GT(scores.iou[k], 0.9) << "door " << k + 1;
+}
+
 TEST(DefaultPredictor, ClipsRoomsToTheKnownOutlineBesideThem) {
   cv::Mat1b known = cv::Mat1b::zeros(100, 100);
   known(cv::Rect(60, 20, 30, 60)).setTo(255);  // an explored room beside the hidden one, rows 20..79
@@ -240,11 +264,11 @@ TEST(DefaultPredictor, ClipsRoomsToTheKnownOutlineBesideThem) {
 }
 
 // Mean IoU of `default` over the benchmark's 44 valid cases; the floor sits a little under the measured mean
-// (0.670), so that a regression fails.
+// (0.690), so that a regression fails.
 TEST(DefaultPredictor, KeepsItsAccuracyOnTheBenchmark) {
   HIDDEN_ROOMS_REQUIRE_SHARED_DATA();
   int cases = 0;
-  EXPECT_GE(testing::benchmarkMeanIou("default", &cases), 0.66);
+  EXPECT_GE(testing::benchmarkMeanIou("default", &cases), 0.68);
   EXPECT_EQ(cases, 44);
 }
 

@@ -47,18 +47,8 @@ class MapperTest : public ::testing::Test {
   // The wander's command for each scan while driving; zero afterwards.
   void onScan(const sensor_msgs::LaserScan::ConstPtr& scan) {
     scans_.push_back(scan);
-    geometry_msgs::Twist twist;
-    if (driving_) {
-      LaserGeometry laser;
-      laser.beams = static_cast<int>(scan->ranges.size());
-      laser.angle_min = scan->angle_min;
-      laser.angle_increment = scan->angle_increment;
-      laser.max_range = scan->range_max;
-      const VelocityCommand command = driver_.next(scan->ranges, laser);
-      twist.linear.x = command.linear;
-      twist.angular.z = command.angular;
-    }
-    command_publisher_.publish(twist);
+    const VelocityCommand command = driving_ ? driver_.next(scan->ranges, laserGeometryOf(*scan)) : VelocityCommand();
+    command_publisher_.publish(toRos(command));
   }
 
   template <typename Condition>

@@ -23,6 +23,7 @@
 #include <sensor_msgs/LaserScan.h>
 
 #include "hidden_rooms/occupancy_grid.h"
+#include "hidden_rooms/ros/conversions.h"
 #include "hidden_rooms/wander_driver.h"
 #include "test_util.h"
 
@@ -70,18 +71,8 @@ class MapperFaultsTest : public ::testing::Test {
   }
 
   void onScan(const sensor_msgs::LaserScan::ConstPtr& scan) {
-    geometry_msgs::Twist twist;
-    if (driving_) {
-      LaserGeometry laser;
-      laser.beams = static_cast<int>(scan->ranges.size());
-      laser.angle_min = scan->angle_min;
-      laser.angle_increment = scan->angle_increment;
-      laser.max_range = scan->range_max;
-      const VelocityCommand command = driver_.next(scan->ranges, laser);
-      twist.linear.x = command.linear;
-      twist.angular.z = command.angular;
-    }
-    command_publisher_.publish(twist);
+    const VelocityCommand command = driving_ ? driver_.next(scan->ranges, laserGeometryOf(*scan)) : VelocityCommand();
+    command_publisher_.publish(toRos(command));
     if (relaying_) relay(scan);
   }
 

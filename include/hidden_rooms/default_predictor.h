@@ -1,11 +1,11 @@
 #pragma once
 
-// The project's own prediction method, "default": per closed door, the room grown on the layout's cell grid by
-// the thesis's method (thesis_predictor.h, with its default parameters), or a rectangle fitted to the walls the
-// robot saw around the door when the grown room is smaller than default_grown_area_ratio times the rectangle
-// (the growth stopped short of the walls the rectangle found) or missing. A rectangle gives up the pixels of
-// the grown rooms kept for the other doors. On a map whose dominant wall angle is at least default_min_rotation
-// (the layout's cells are axis-aligned) every door gets its rectangle.
+// The project's own prediction method, "default": per closed door, a rectangle fitted to the walls the robot saw
+// around the door, or the room grown on the layout's cell grid by the thesis's method (thesis_predictor.h, with
+// its default parameters) when that room is at least default_grown_area_ratio times the rectangle (the
+// rectangle stopped short, e.g. of an L-shaped room) or the rectangle is missing. A rectangle gives up
+// the pixels of the grown rooms kept for the other doors. On a map whose dominant wall angle is at least
+// default_min_rotation (the layout's cells are axis-aligned) every door gets its rectangle.
 //
 // The rectangles:
 // 1. Orientation: the dominant wall direction (modulo 90 degrees) from the gradient directions of the occupied
@@ -21,6 +21,9 @@
 //      median when enough columns end on a known pixel inside the known map's bounding box, else a prior: the
 //      depth of the explored rooms on the same side of the same wall, else of the other hidden rooms on that
 //      side, else the room's width (a square, as the thesis does).
+//    - overlapping rectangles of doors on perpendicular walls: the overlap goes to the door nearer to it (along
+//      that door's normal) and the other room ends where the overlap begins, if it keeps default_min_depth;
+//      other overlaps are cut halfway between the doors;
 // 3. The rectangle's unknown pixels connected to the door; pixels claimed by several rooms go to the nearest
 //    door.
 // Lateral extent and wall stubs: a stub ends the extent unless the wall goes on past it at another row (the side

@@ -23,7 +23,7 @@ constexpr double kBoundedFraction = 0.5;     // share of columns ending on a kno
 constexpr double kNeighbourReach = 15.0;     // m: how far along the wall explored neighbours are looked for
 constexpr double kMinDepth = 2.0;            // m: smallest depth taken from the square prior
 constexpr double kMinRotation = 1.0;         // degrees: smaller dominant angles are not corrected
-constexpr double kGrownAreaRatio = 0.6;      // grown rooms smaller than this share of the rectangle give way
+constexpr double kGrownAreaRatio = 1.25;     // grown rooms less than this many times the rectangle give way
 constexpr double kStubLength = 0.3;          // m: wall stubs this long into the explored side end a room's extent
 constexpr double kOutlineReach = 15.0;       // m: band beside a room within which the known map's extent bounds it
 
@@ -275,6 +275,23 @@ cv::Point doorPixel(const OccupancyGrid& map, const MapDoor& door) {
   return {static_cast<int>(std::floor(image.x())), static_cast<int>(std::floor(image.y()))};
 }
 
+// Pixels from a door's first unknown row `entry` to the near side of `box`, along the door's normal.
+int gapAlongNormal(const DoorFrame& d, const cv::Point& entry, const cv::Rect& box) {
+  if (d.n.x > 0) return box.x - entry.x;
+  if (d.n.x < 0) return entry.x - (box.br().x - 1);
+  if (d.n.y > 0) return box.y - entry.y;
+  return entry.y - (box.br().y - 1);
+}
+
+// The part of a room's rectangle before `box`, along the door's normal.
+cv::Rect endBefore(const DoorFrame& d, cv::Rect room, const cv::Rect& box) {
+  if (d.n.x > 0) room.width = std::max(0, box.x - room.x);
+  else if (d.n.x < 0) room.width = std::max(0, room.br().x - box.br().x), room.x = box.br().x;
+  else if (d.n.y > 0) room.height = std::max(0, box.y - room.y);
+  else room.height = std::max(0, room.br().y - box.br().y), room.y = box.br().y;
+  return room;
+}
+
 // Rotation of a point about the working transform.
 cv::Point2d applyAffine(const cv::Matx23d& m, const cv::Point2d& p) {
   return {m(0, 0) * p.x + m(0, 1) * p.y + m(0, 2), m(1, 0) * p.x + m(1, 1) * p.y + m(1, 2)};
@@ -463,6 +480,7 @@ std::vector<RoomPrediction> rectangleRooms(const PredictionRequest& request, con
     rects[i] = cv::Rect(cv::Point(std::min(c1.x, c2.x), std::min(c1.y, c2.y)),
                         cv::Point(std::max(c1.x, c2.x) + 1, std::max(c1.y, c2.y) + 1));
   }
+  const int min_depth_px = std::max(1, static_cast<int>(std::lround(P.min_depth / resolution)));
   for (size_t i = 0; i < count; ++i)
     for (size_t j = i + 1; j < count; ++j) {
       if (!doors[i].ok || !doors[j].ok || (rects[i] & rects[j]).area() == 0) continue;
@@ -486,6 +504,19 @@ std::vector<RoomPrediction> rectangleRooms(const PredictionRequest& request, con
         cut(rj, ci < cj ? mid : -big, ci < cj ? big : mid, cut_x);
         return ci != cj;
       };
+      // Doors on perpendicular walls: the overlap goes to the door nearer to it (along that door's normal); the
+      // other room ends where the overlap begins, when it keeps at least the smallest depth that way.
+      if ((doors[i].n.x != 0) != (doors[j].n.x != 0)) {
+        const cv::Rect overlap = rects[i] & rects[j];
+        const int gap_i = gapAlongNormal(doors[i], pi, overlap), gap_j = gapAlongNormal(doors[j], pj, overlap);
+        const size_t farther = gap_i > gap_j ? i : j;
+        const cv::Rect shortened = endBefore(doors[farther], rects[farther], overlap);
+        const int kept_depth = doors[farther].n.x != 0 ? shortened.width : shortened.height;
+        if (gap_i != gap_j && kept_depth >= min_depth_px) {
+          rects[farther] = shortened;
+          continue;
+        }
+      }
       // Both cuts are tried; the one keeping more of the two rooms wins (doors in line: only the cut between).
       cv::Rect xi = rects[i], xj = rects[j], yi = rects[i], yj = rects[j];
       const bool x_ok = split(true, &xi, &xj), y_ok = split(false, &yi, &yj);

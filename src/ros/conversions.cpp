@@ -363,6 +363,22 @@ visualization_msgs::MarkerArray toDebugMarkers(const OccupancyGrid& map, const L
 
 VelocityCommand fromRos(const geometry_msgs::Twist& message) { return {message.linear.x, message.angular.z}; }
 
+geometry_msgs::Twist toRos(const VelocityCommand& command) {
+  geometry_msgs::Twist message;
+  message.linear.x = command.linear;
+  message.angular.z = command.angular;
+  return message;
+}
+
+LaserGeometry laserGeometryOf(const sensor_msgs::LaserScan& message) {
+  LaserGeometry laser;
+  laser.beams = static_cast<int>(message.ranges.size());
+  laser.angle_min = message.angle_min;
+  laser.angle_increment = message.angle_increment;
+  laser.max_range = message.range_max;
+  return laser;
+}
+
 sensor_msgs::LaserScan toRos(const std::vector<float>& ranges, const LaserGeometry& laser, double min_range,
                              double scan_time, const std::string& frame_id, const ros::Time& stamp) {
   sensor_msgs::LaserScan message;

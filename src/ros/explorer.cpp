@@ -348,10 +348,7 @@ void Explorer::publishCommand(const VelocityCommand& command) {
   const bool stop = command.linear == 0.0 && command.angular == 0.0;
   if (stop && stopped_) return;  // one stop is enough (the simulator's watchdog also stops a silent robot)
   stopped_ = stop;
-  geometry_msgs::Twist message;
-  message.linear.x = command.linear;
-  message.angular.z = command.angular;
-  command_publisher_.publish(message);
+  command_publisher_.publish(toRos(command));
 }
 
 void Explorer::publishMarkers(const FrontierMap& frontiers, const ros::Time& now) {

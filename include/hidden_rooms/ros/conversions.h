@@ -68,6 +68,9 @@ visualization_msgs::MarkerArray toDebugMarkers(const OccupancyGrid& map, const L
 
 // Simulator. A velocity command as it came (non-finite values pass: Simulation::setCommand rejects them).
 VelocityCommand fromRos(const geometry_msgs::Twist& message);
+geometry_msgs::Twist toRos(const VelocityCommand& command);
+// The beams of a scan message (count, first angle, increment, range_max).
+LaserGeometry laserGeometryOf(const sensor_msgs::LaserScan& message);
 // A scan of `laser` (ranges per beam, metres) in `frame_id`; scan_time = the laser's period.
 sensor_msgs::LaserScan toRos(const std::vector<float>& ranges, const LaserGeometry& laser, double min_range,
                              double scan_time, const std::string& frame_id, const ros::Time& stamp);
