@@ -163,5 +163,56 @@ TEST(Frontier, UnreachableFrontierGivesNoGoal) {
   EXPECT_TRUE(nearestFrontierGoal(frontiers, planner, Blacklist(), FrontierOptions()).has_value());
 }
 
+TEST(Frontier, GoalsKeepRobotRadiusButPathsPassNarrowDoors) {
+  // Known room x = 0.2..4.0 with a wall at x = 4.0..4.2 and a 0.6 m door in it (6 free cells: its centre is 0.3 m
+  // from the jambs); behind the door 1 m of known floor, then unknown space (a frontier at x = 5.15).
+  OccupancyGrid grid = unknownGrid(100, 40);
+  grid.cells(cv::Rect(2, 0, 50, 40)).setTo(OccupancyGrid::kOccupied);
+  grid.cells(cv::Rect(3, 1, 37, 38)).setTo(OccupancyGrid::kFree);
+  grid.cells(cv::Rect(40, 17, 2, 6)).setTo(OccupancyGrid::kFree);  // the door, rows 17..22
+  grid.cells(cv::Rect(42, 1, 10, 38)).setTo(OccupancyGrid::kFree);  // behind it, up to the frontier
+  const FrontierMap frontiers = findFrontiers(grid);
+  ASSERT_EQ(frontiers.frontiers.size(), 1u);
+
+  GridPlannerOptions planner_options;
+  planner_options.robot_radius = 0.38;
+  planner_options.min_clearance = 0.25;
+  GridPlanner planner(planner_options);
+  planner.setMap(grid);
+  ASSERT_TRUE(planner.computeCostsFrom(Point2(2.0, 2.0)));
+  const std::optional<FrontierGoal> goal = nearestFrontierGoal(frontiers, planner, Blacklist(), FrontierOptions());
+  ASSERT_TRUE(goal.has_value());
+  EXPECT_GT(goal->position.x(), 4.2);  // through the door
+  EXPECT_NE(planner.roomy()(goal->cell.y, goal->cell.x), 0);
+
+  // With the inflation at robot_radius the door is closed and the frontier unreachable.
+  planner_options.min_clearance = planner_options.robot_radius;
+  GridPlanner strict(planner_options);
+  strict.setMap(grid);
+  ASSERT_TRUE(strict.computeCostsFrom(Point2(2.0, 2.0)));
+  EXPECT_FALSE(nearestFrontierGoal(frontiers, strict, Blacklist(), FrontierOptions()).has_value());
+
+  // A frontier in the door (the floor beyond it unknown): the cells within goal_reach (0.3 m here) of it are in
+  // the door's narrow band, traversable and reachable but not roomy, so no goal there.
+  grid.cells(cv::Rect(42, 0, 10, 39)).setTo(OccupancyGrid::kUnknown);
+  planner_options.min_clearance = 0.25;
+  GridPlanner narrow(planner_options);
+  narrow.setMap(grid);
+  ASSERT_TRUE(narrow.computeCostsFrom(Point2(2.0, 2.0)));
+  FrontierOptions door_options;
+  door_options.min_frontier_cells = 4;  // the door's 6 cells
+  door_options.goal_reach = 0.3;
+  const FrontierMap door_frontier = findFrontiers(grid, door_options);
+  ASSERT_EQ(door_frontier.frontiers.size(), 1u);
+  EXPECT_EQ(door_frontier.frontiers[0].cells.front().x, 41);
+  EXPECT_TRUE(std::isfinite(narrow.costTo(40, 19)));  // in the door: reachable ...
+  EXPECT_EQ(narrow.roomy()(19, 40), 0);                // ... but not roomy
+  EXPECT_FALSE(nearestFrontierGoal(door_frontier, narrow, Blacklist(), door_options).has_value());
+  door_options.goal_reach = 0.6;  // roomy cells of the room within reach: a goal before the door
+  const std::optional<FrontierGoal> before_door = nearestFrontierGoal(door_frontier, narrow, Blacklist(), door_options);
+  ASSERT_TRUE(before_door.has_value());
+  EXPECT_LT(before_door->position.x(), 3.9);
+}
+
 }  // namespace
 }  // namespace hidden_rooms

@@ -25,6 +25,7 @@ OccupancyGrid room(bool wall) {
 GridPlannerOptions plainLengths() {
   GridPlannerOptions options;
   options.robot_radius = 0.33;
+  options.min_clearance = 0.33;  // no narrow band: the inflation is robot_radius
   options.cost_weight = 0.0;  // cost = length
   options.smoothing_window = 0.0;
   return options;
@@ -112,6 +113,7 @@ TEST(GridPlanner, UnknownCellsAreNotTraversable) {
 TEST(GridPlanner, StartInTheInflationEscapesToTheNearestFreeCell) {
   GridPlannerOptions options;
   options.robot_radius = 0.33;
+  options.min_clearance = 0.33;
   GridPlanner planner(options);
   planner.setMap(room(false));
   ASSERT_TRUE(planner.computeCostsFrom(Point2(0.2, 3.0)));  // 0.1 m from the left wall
@@ -120,6 +122,85 @@ TEST(GridPlanner, StartInTheInflationEscapesToTheNearestFreeCell) {
   EXPECT_NEAR(planner.map().cellCentre(start.x, start.y).x(), 0.45, 1e-9);  // first cell >= 0.33 m from the wall
   EXPECT_TRUE(std::isfinite(planner.costTo(Point2(6.0, 3.0))));
   EXPECT_FALSE(planner.computeCostsFrom(Point2(-5.0, 3.0)));  // outside the map
+}
+
+// The room split by a wall at x = 4.0..4.1 with a door of `gap` metres (centred at y = 3.0).
+OccupancyGrid roomWithDoor(double gap) {
+  OccupancyGrid grid = room(false);
+  grid.cells(cv::Rect(40, 0, 1, 60)).setTo(OccupancyGrid::kOccupied);
+  const int cells = static_cast<int>(std::lround(gap / grid.resolution));
+  grid.cells(cv::Rect(40, 30 - cells / 2, 1, cells)).setTo(OccupancyGrid::kFree);
+  return grid;
+}
+
+TEST(GridPlanner, DoorNarrowerThanTwoRobotRadiiIsPassableThroughTheNarrowBand) {
+  // A door of 6 free cells (0.6 m): the centre keeps at most 0.3 m from its jambs (cell centres), under
+  // robot_radius but above min_clearance.
+  GridPlannerOptions options;
+  options.robot_radius = 0.38;
+  options.min_clearance = 0.25;
+  GridPlanner planner(options);
+  planner.setMap(roomWithDoor(0.6));
+  ASSERT_TRUE(planner.computeCostsFrom(Point2(2.0, 3.0)));
+  int col = 0, row = 0;
+  ASSERT_TRUE(planner.map().cellOf(Point2(6.0, 3.0), &col, &row));
+  ASSERT_TRUE(std::isfinite(planner.costTo(col, row)));
+  EXPECT_NE(planner.roomy()(row, col), 0);
+  bool narrow = false;
+  for (const Point2& point : planner.pathTo(col, row)) {
+    int c = 0, r = 0;
+    ASSERT_TRUE(planner.map().cellOf(point, &c, &r));
+    EXPECT_GE(planner.obstacleDistance()(r, c), 0.25 - 1e-6);
+    narrow |= planner.roomy()(r, c) == 0;
+  }
+  EXPECT_TRUE(narrow);  // through the door's narrow band
+  // The door cells are traversable but not roomy (no goal in a doorway).
+  ASSERT_TRUE(planner.map().cellOf(Point2(4.05, 2.95), &col, &row));
+  EXPECT_NE(planner.traversable()(row, col), 0);
+  EXPECT_EQ(planner.roomy()(row, col), 0);
+
+  // With the inflation at robot_radius (min_clearance = robot_radius) the same door is closed, and so is a
+  // 0.4 m one (0.2 m from the jambs) with min_clearance 0.25.
+  options.min_clearance = options.robot_radius;
+  GridPlanner strict(options);
+  strict.setMap(roomWithDoor(0.6));
+  ASSERT_TRUE(strict.computeCostsFrom(Point2(2.0, 3.0)));
+  EXPECT_TRUE(std::isinf(strict.costTo(Point2(6.0, 3.0))));
+  options.min_clearance = 0.25;
+  GridPlanner narrow_door(options);
+  narrow_door.setMap(roomWithDoor(0.4));
+  ASSERT_TRUE(narrow_door.computeCostsFrom(Point2(2.0, 3.0)));
+  EXPECT_TRUE(std::isinf(narrow_door.costTo(Point2(6.0, 3.0))));
+}
+
+TEST(GridPlanner, NarrowBandOnlyWhereThereIsNoRoomyWay) {
+  // Around the end of the wall (1.9 m of room above it) the path keeps robot_radius although cutting the corner
+  // through the narrow band would be shorter: narrow cells cost narrow_cost_factor times more.
+  GridPlannerOptions options;
+  options.cost_weight = 0.0;
+  options.smoothing_window = 0.0;
+  GridPlanner planner(options);
+  planner.setMap(room(true));
+  ASSERT_TRUE(planner.computeCostsFrom(Point2(2.0, 1.0)));
+  int col = 0, row = 0;
+  ASSERT_TRUE(planner.map().cellOf(Point2(6.0, 1.0), &col, &row));
+  for (const Point2& point : planner.pathTo(col, row)) {
+    int c = 0, r = 0;
+    ASSERT_TRUE(planner.map().cellOf(point, &c, &r));
+    EXPECT_NE(planner.roomy()(r, c), 0);
+  }
+  // Without the extra cost the shortest way cuts through the band.
+  options.narrow_cost_factor = 1.0;
+  GridPlanner cutting(options);
+  cutting.setMap(room(true));
+  ASSERT_TRUE(cutting.computeCostsFrom(Point2(2.0, 1.0)));
+  bool narrow = false;
+  for (const Point2& point : cutting.pathTo(col, row)) {
+    int c = 0, r = 0;
+    ASSERT_TRUE(cutting.map().cellOf(point, &c, &r));
+    narrow |= cutting.roomy()(r, c) == 0;
+  }
+  EXPECT_TRUE(narrow);
 }
 
 TEST(GridPlanner, EmptyMapPlansNothing) {
@@ -136,6 +217,12 @@ TEST(GridPlanner, RejectsBadOptions) {
   EXPECT_THROW(GridPlanner{options}, InputError);
   options = GridPlannerOptions();
   options.cost_radius = 0.1;  // below robot_radius
+  EXPECT_THROW(GridPlanner{options}, InputError);
+  options = GridPlannerOptions();
+  options.min_clearance = 0.5;  // above robot_radius
+  EXPECT_THROW(GridPlanner{options}, InputError);
+  options = GridPlannerOptions();
+  options.narrow_cost_factor = 0.5;
   EXPECT_THROW(GridPlanner{options}, InputError);
 }
 

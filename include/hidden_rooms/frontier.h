@@ -59,8 +59,8 @@ struct FrontierGoal {
   double cost = std::numeric_limits<double>::infinity();  // the planner's path cost to it
 };
 
-// The frontier nearest by path cost: over every traversable cell reachable in `planner`'s last search that lies
-// within options.goal_reach of a frontier cell, at least options.min_goal_distance from the search's start cell
+// The frontier nearest by path cost: over every roomy cell (planner.roomy(): at least robot_radius from obstacles)
+// reachable in `planner`'s last search that lies within options.goal_reach of a frontier cell, at least options.min_goal_distance from the search's start cell
 // and not in `blacklist`, the cheapest. With `previous` (the goal
 // being driven to; min_goal_distance does not apply to it), that goal is kept while some frontier is still within goal_reach of it and it costs at most
 // `hysteresis` metres more than the best (so replanning on every map does not make the robot dither). Nothing

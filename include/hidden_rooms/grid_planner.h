@@ -12,7 +12,12 @@ namespace hidden_rooms {
 struct GridPlannerOptions {
   int free_threshold = 19;        // cells with 0 <= value <= this are free (map_saver's 0.196)
   int occupied_threshold = 65;    // cells with value >= this are obstacles (map_saver's 0.65)
-  double robot_radius = 0.38;     // metres: cells closer than this to an obstacle cannot hold the robot's centre
+  double robot_radius = 0.38;     // metres: the clearance paths keep where they can; goals keep it always
+  double min_clearance = 0.30;    // metres: cells closer than this to an obstacle cannot hold the robot's centre;
+                                  // between this and robot_radius only paths pass (no goals), at narrow_cost_factor
+                                  // times the highest proximity cost, so that a door the map draws narrower than
+                                  // 2 robot_radius stays passable
+  double narrow_cost_factor = 3.0;  // >= 1
   double cost_radius = 1.0;       // metres: within this distance of an obstacle a cell costs extra ...
   double cost_weight = 10.0;      // ... up to 1 + cost_weight times its length at robot_radius, falling linearly
   double start_escape_radius = 0.5;  // metres: a start cell in the inflated zone is replaced by the nearest
@@ -24,8 +29,9 @@ struct GridPlannerOptions {
 void validate(const GridPlannerOptions& options);
 
 // Wavefront (Dijkstra) planner on an occupancy grid. Obstacles (value >= occupied_threshold) are inflated by
-// robot_radius with a distance transform; the robot's centre may stand on free cells outside the inflation
-// (unknown cells are neither obstacle nor traversable). Moving between 8-neighbours costs the step's length
+// min_clearance with a distance transform; the robot's centre may stand on free cells outside the inflation
+// (unknown cells are neither obstacle nor traversable); cells at least robot_radius from obstacles are roomy (goals
+// go there). Moving between 8-neighbours costs the step's length
 // (metres) times the mean of the two cells' proximity factors, so paths keep away from walls where they can.
 class GridPlanner {
  public:
@@ -43,8 +49,10 @@ class GridPlanner {
   // outside the grid.
   double costTo(int col, int row) const;
   double costTo(const Point2& point) const;
-  // 255 where the robot's centre may stand (free and outside the inflation), else 0.
+  // 255 where the robot's centre may stand (free and at least min_clearance from obstacles), else 0.
   const cv::Mat1b& traversable() const { return traversable_; }
+  // 255 where it stands with room to spare (traversable and at least robot_radius from obstacles), else 0.
+  const cv::Mat1b& roomy() const { return roomy_; }
   // Distance (metres) from each cell to the nearest obstacle cell.
   const cv::Mat1f& obstacleDistance() const { return obstacle_distance_; }
   // Cell where the last search started (the start or the cell it escaped to); (-1, -1) before any.
@@ -59,6 +67,7 @@ class GridPlanner {
   GridPlannerOptions options_;
   OccupancyGrid map_;
   cv::Mat1b traversable_;
+  cv::Mat1b roomy_;
   cv::Mat1f obstacle_distance_;
   cv::Mat1f step_factor_;  // proximity factor of each cell (>= 1)
   cv::Mat1d cost_;         // path cost from the start (infinity where unreachable)

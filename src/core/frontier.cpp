@@ -86,7 +86,7 @@ std::optional<FrontierGoal> nearestFrontierGoal(const FrontierMap& frontiers, co
   const OccupancyGrid& map = planner.map();
   if (map.empty() || frontiers.frontiers.empty() || planner.startCell().x < 0) return std::nullopt;
   const int reach = static_cast<int>(std::floor(options.goal_reach / map.resolution));
-  const cv::Mat1b& traversable = planner.traversable();
+  const cv::Mat1b& roomy = planner.roomy();  // goals keep robot_radius from obstacles
 
   const Point2 robot = map.cellCentre(planner.startCell().x, planner.startCell().y);
   const auto acceptable = [&](const Point2& position) {
@@ -99,7 +99,7 @@ std::optional<FrontierGoal> nearestFrontierGoal(const FrontierMap& frontiers, co
     for (const cv::Point& cell : frontier.cells) {
       for (int row = std::max(0, cell.y - reach); row <= std::min(map.height() - 1, cell.y + reach); ++row)
         for (int col = std::max(0, cell.x - reach); col <= std::min(map.width() - 1, cell.x + reach); ++col) {
-          if (claimed(row, col) != 0 || traversable(row, col) == 0) continue;
+          if (claimed(row, col) != 0 || roomy(row, col) == 0) continue;
           if ((col - cell.x) * (col - cell.x) + (row - cell.y) * (row - cell.y) > reach * reach) continue;
           claimed(row, col) = frontier.label;
           const double cost = planner.costTo(col, row);

@@ -27,6 +27,11 @@ void validate(const GridPlannerOptions& options) {
               options.occupied_threshold <= 100,
           "need 0 <= free_threshold < occupied_threshold <= 100");
   require(std::isfinite(options.robot_radius) && options.robot_radius >= 0.0, "robot_radius must be >= 0");
+  require(std::isfinite(options.min_clearance) && options.min_clearance >= 0.0 &&
+              options.min_clearance <= options.robot_radius,
+          "need 0 <= min_clearance <= robot_radius");
+  require(std::isfinite(options.narrow_cost_factor) && options.narrow_cost_factor >= 1.0,
+          "narrow_cost_factor must be >= 1");
   require(std::isfinite(options.cost_radius) && options.cost_radius >= options.robot_radius,
           "cost_radius must be >= robot_radius");
   require(std::isfinite(options.cost_weight) && options.cost_weight >= 0.0, "cost_weight must be >= 0");
@@ -43,6 +48,7 @@ void GridPlanner::setMap(const OccupancyGrid& map) {
   start_cell_ = {-1, -1};
   const int rows = map.height(), cols = map.width();
   traversable_ = cv::Mat1b::zeros(rows, cols);
+  roomy_ = cv::Mat1b::zeros(rows, cols);
   obstacle_distance_ = cv::Mat1f(rows, cols, std::numeric_limits<float>::max());
   step_factor_ = cv::Mat1f(rows, cols, 1.0f);
   cost_ = cv::Mat1d(rows, cols, kInfinity);
@@ -66,11 +72,13 @@ void GridPlanner::setMap(const OccupancyGrid& map) {
     for (int col = 0; col < cols; ++col) {
       const int value = map.cells(row, col);
       const double distance = obstacle_distance_(row, col);
-      if (value >= 0 && value <= options_.free_threshold && distance >= options_.robot_radius)
-        traversable_(row, col) = 255;
+      const bool free = value >= 0 && value <= options_.free_threshold;
+      if (free && distance >= options_.min_clearance) traversable_(row, col) = 255;
+      if (free && distance >= options_.robot_radius) roomy_(row, col) = 255;
       const double closeness = band > 0.0 ? std::clamp((options_.cost_radius - distance) / band, 0.0, 1.0)
                                           : (distance < options_.cost_radius ? 1.0 : 0.0);
-      step_factor_(row, col) = static_cast<float>(1.0 + options_.cost_weight * closeness);
+      const double narrow = distance < options_.robot_radius ? options_.narrow_cost_factor : 1.0;
+      step_factor_(row, col) = static_cast<float>(narrow * (1.0 + options_.cost_weight * closeness));
     }
 }
 

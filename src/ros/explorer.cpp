@@ -39,6 +39,8 @@ ExplorerOptions readExplorerOptions(const ros::NodeHandle& nh) {
   nh.param("free_threshold", planner.free_threshold, planner.free_threshold);
   nh.param("occupied_threshold", planner.occupied_threshold, planner.occupied_threshold);
   nh.param("robot_radius", planner.robot_radius, planner.robot_radius);
+  nh.param("min_clearance", planner.min_clearance, planner.min_clearance);
+  nh.param("narrow_cost_factor", planner.narrow_cost_factor, planner.narrow_cost_factor);
   nh.param("cost_radius", planner.cost_radius, planner.cost_radius);
   nh.param("cost_weight", planner.cost_weight, planner.cost_weight);
   nh.param("start_escape_radius", planner.start_escape_radius, planner.start_escape_radius);
