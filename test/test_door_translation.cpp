@@ -172,6 +172,31 @@ TEST(DoorTranslation, ReachableFreeCellsStopAtWalls) {
   EXPECT_THROW(reachableFreeArea(grid, Point2(-1.0, 1.0)), InputError);
 }
 
+// Three rooms in a row, 2 m deep: a 1 m gap into the middle one, a 0.4 m gap on to the last. A robot 0.5 m wide
+// (clearance 0.25 m) reaches the middle room but not the last; without a clearance every free cell counts.
+TEST(DoorTranslation, ReachableAreaWithAClearanceStopsAtGapsNarrowerThanTheRobot) {
+  OccupancyGrid grid;
+  grid.resolution = 0.05;
+  grid.cells = cv::Mat_<int8_t>(40, 180, OccupancyGrid::kFree);
+  grid.cells.row(0).setTo(OccupancyGrid::kOccupied);
+  grid.cells.row(39).setTo(OccupancyGrid::kOccupied);
+  grid.cells.col(0).setTo(OccupancyGrid::kOccupied);
+  grid.cells.col(179).setTo(OccupancyGrid::kOccupied);
+  grid.cells(cv::Rect(60, 0, 2, 40)).setTo(OccupancyGrid::kOccupied);
+  grid.cells(cv::Rect(60, 10, 2, 20)).setTo(OccupancyGrid::kFree);   // 1 m gap
+  grid.cells(cv::Rect(120, 0, 2, 40)).setTo(OccupancyGrid::kOccupied);
+  grid.cells(cv::Rect(120, 16, 2, 8)).setTo(OccupancyGrid::kFree);   // 0.4 m gap
+  const Point2 start(1.0, 1.0);
+  const cv::Mat1b all_free = reachableFreeArea(grid, start);
+  EXPECT_EQ(cv::countNonZero(all_free), cv::countNonZero(grid.cells == OccupancyGrid::kFree));
+  const cv::Mat1b robot = reachableFreeArea(grid, start, 0.25);
+  EXPECT_EQ(cv::countNonZero(robot(cv::Rect(125, 0, 55, 40))), 0);  // the last room past the body poking in
+  EXPECT_GT(cv::countNonZero(robot(cv::Rect(62, 0, 58, 40))), 0.9 * 58 * 38);  // the middle room, corners aside
+  EXPECT_EQ(robot(20, 30), 255);
+  EXPECT_EQ(cv::countNonZero(robot & (grid.cells != OccupancyGrid::kFree)), 0);
+  EXPECT_THROW(reachableFreeArea(grid, start, -0.1), InputError);
+}
+
 TEST(DoorTranslation, MovesTheTrueRoomsIntoTheMapGrid) {
   const Environment environment = loadEnvironment(std::string(HIDDEN_ROOMS_SOURCE_DIR) + "/worlds/small_1.xml");
   const std::vector<int> closable = closableDoors(environment);

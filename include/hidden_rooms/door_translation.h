@@ -56,9 +56,12 @@ cv::Mat1w spaceLabelsInMap(const RenderedEnvironment& rendered, const OccupancyG
 cv::Mat1w trueRoomsInMap(const Environment& environment, const std::vector<int>& door_indices,
                          const cv::Mat1w& space_labels_in_map);
 
-// Free cells of `rendered` a robot starting at `start` (world frame) can reach (reachableFreeCells from the free
-// cell nearest to it, within a few cells). Throws InputError when `start` is outside the grid or not near free
-// space.
-cv::Mat1b reachableFreeArea(const OccupancyGrid& rendered, const Point2& start);
+// Free cells of `rendered` a robot starting at `start` (world frame) can reach. With `clearance` 0 every free cell
+// 4-connected to the free cell nearest the start (within a few cells); with a clearance (metres, the robot's
+// half width) the free cells its body can cover: within `clearance` of a centre position that keeps `clearance`
+// from every non-free cell and is connected to the start through such positions (a room behind a gap narrower
+// than the robot is not reachable). Throws InputError when `start` is outside the grid or not near free space
+// (with a clearance: no centre position within 1 m of it).
+cv::Mat1b reachableFreeArea(const OccupancyGrid& rendered, const Point2& start, double clearance = 0.0);
 
 }  // namespace hidden_rooms

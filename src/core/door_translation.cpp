@@ -1,9 +1,11 @@
 #include "hidden_rooms/door_translation.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
 #include <Eigen/Geometry>
+#include <opencv2/imgproc.hpp>
 
 #include "hidden_rooms/input_error.h"
 #include "hidden_rooms/range_scan.h"
@@ -132,25 +134,44 @@ cv::Mat1w trueRoomsInMap(const Environment& environment, const std::vector<int>&
   return rooms;
 }
 
-cv::Mat1b reachableFreeArea(const OccupancyGrid& rendered, const Point2& start) {
+cv::Mat1b reachableFreeArea(const OccupancyGrid& rendered, const Point2& start, double clearance) {
+  if (!(clearance >= 0.0)) throw InputError("reachable area", "the clearance must be zero or positive");
   int start_col = 0, start_row = 0;
   if (!rendered.cellOf(start, &start_col, &start_row))
     throw InputError("reachable area", "the start position lies outside the world's grid");
-  // The nearest free cell within a few cells (a start pose drawn on a wall's edge).
+  const cv::Mat1b free_cells = rendered.cells == OccupancyGrid::kFree;
+  // The cells a robot centre may take: all free ones, or those `clearance` away from every non-free cell.
+  cv::Mat1b centres;
+  if (clearance > 0.0) {
+    cv::Mat1f distance;
+    cv::distanceTransform(free_cells, distance, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+    centres = distance * rendered.resolution >= clearance;
+  } else {
+    centres = free_cells;
+  }
+  // The nearest centre cell near the start (a start pose drawn on a wall's edge, or closer to it than the clearance).
+  const int search = clearance > 0.0 ? std::max(kStartSearchCells, static_cast<int>(std::ceil(1.0 / rendered.resolution)))
+                                     : kStartSearchCells;
   cv::Point seed(-1, -1);
   int best = std::numeric_limits<int>::max();
-  for (int dr = -kStartSearchCells; dr <= kStartSearchCells; ++dr) {
-    for (int dc = -kStartSearchCells; dc <= kStartSearchCells; ++dc) {
+  for (int dr = -search; dr <= search; ++dr) {
+    for (int dc = -search; dc <= search; ++dc) {
       const int row = start_row + dr, col = start_col + dc;
-      if (row < 0 || col < 0 || row >= rendered.height() || col >= rendered.width() ||
-          rendered.cells(row, col) != OccupancyGrid::kFree || dr * dr + dc * dc >= best)
+      if (row < 0 || col < 0 || row >= rendered.height() || col >= rendered.width() || !centres(row, col) ||
+          dr * dr + dc * dc >= best)
         continue;
       best = dr * dr + dc * dc;
       seed = cv::Point(col, row);
     }
   }
   if (seed.x < 0) throw InputError("reachable area", "the start position is not in free space");
-  return reachableFreeCells(rendered, seed.x, seed.y);
+  if (clearance <= 0.0) return reachableFreeCells(rendered, seed.x, seed.y);
+  cv::Mat1b mask = cv::Mat1b::zeros(rendered.height() + 2, rendered.width() + 2);
+  cv::floodFill(centres, mask, seed, 255, nullptr, 0, 0, 4 | cv::FLOODFILL_MASK_ONLY | (255 << 8));
+  cv::Mat1b body = mask(cv::Rect(1, 1, rendered.width(), rendered.height())).clone();
+  const int radius = static_cast<int>(std::ceil(clearance / rendered.resolution - 1e-9));
+  cv::dilate(body, body, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * radius + 1, 2 * radius + 1)));
+  return body & free_cells;
 }
 
 }  // namespace hidden_rooms

@@ -37,7 +37,7 @@ from hidden_rooms.package_tools import ToolError, find_binary, tool_error
 SUMMARY_NAME = "summary.csv"
 RESULT_NAME = "result.json"
 SUMMARY_COLUMNS = ["world", "status", "closed_doors", "sim_time_s", "wall_time_s", "path_length_m", "coverage",
-                   "free_iou", "worst_door_error_m", "mean_iou", "message"]
+                   "coverage_all_free", "free_iou", "worst_door_error_m", "mean_iou", "message"]
 MASTER_START_TIMEOUT = 60.0   # wall seconds for roslaunch's master and the simulator's clock
 PR_SET_PDEATHSIG = 1          # prctl option (linux/prctl.h)
 STALL_TIMEOUT = 60.0          # wall seconds without simulated time advancing: the run is stuck
@@ -217,7 +217,8 @@ def post_process(args, out_dir, result):
     with open(os.path.join(out_dir, "exploration.yaml")) as report_file:
         report = yaml.safe_load(report_file)
     doors = report.get("doors") or []
-    result.update(path_length_m=report["path_length"], coverage=report["coverage"], free_iou=report["free_iou"],
+    result.update(path_length_m=report["path_length"], coverage=report["coverage"],
+                  coverage_all_free=report["coverage_all_free"], free_iou=report["free_iou"],
                   worst_door_error_m=max((door["error"] for door in doors), default=""))
     if args.method and doors:
         predict = [find_binary("predict_rooms_offline"), "--map", os.path.join(out_dir, "map.yaml"),
@@ -278,7 +279,7 @@ def run_worker(args):
     out_dir = os.path.join(args.out, world_name(args.world))
     os.makedirs(out_dir, exist_ok=True)
     result = {"world": args.world, "status": "failed", "closed_doors": "", "sim_time_s": "", "wall_time_s": "",
-              "path_length_m": "", "coverage": "", "free_iou": "", "worst_door_error_m": "", "mean_iou": "",
+              "path_length_m": "", "coverage": "", "coverage_all_free": "", "free_iou": "", "worst_door_error_m": "", "mean_iou": "",
               "message": ""}
     started = time.monotonic()
     with open(os.path.join(out_dir, "launch.log"), "w") as log:

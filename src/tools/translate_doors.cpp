@@ -38,7 +38,7 @@ cv::Mat1f distanceToOccupied(const OccupancyGrid& map) {
 int run(int argc, char** argv) {
   po::options_description options("Options");
   std::string environment_path, closed_spec, truth_path, estimate_path, map_path, out_dir;
-  double door_width = 0.9;
+  double door_width = 0.9, robot_radius = 0.25;
   RenderOptions render_options;
   options.add_options()
       ("environment", po::value(&environment_path)->required(), "environment XML the robot explored")
@@ -50,6 +50,9 @@ int run(int argc, char** argv) {
       ("out", po::value(&out_dir)->required(), "output folder (created)")
       ("map", po::value(&map_path), "the explored map (map_server yaml): also score the run")
       ("door-width", po::value(&door_width)->default_value(0.9), "width written for every door, metres")
+      ("robot-radius", po::value(&robot_radius)->default_value(0.25),
+       "half the robot's width, metres: coverage counts the free area a body this wide can reach (0: every free "
+       "cell connected to the start)")
       ("wall-thickness", po::value<double>(), "wall thickness as simulated, metres (default: the world's)");
   po::positional_options_description positional;
   po::variables_map values;
@@ -64,6 +67,7 @@ int run(int argc, char** argv) {
                         options, positional, &values))
     return kExitOk;
   if (!(door_width > 0.0)) throw InputError("--door-width", "must be positive");
+  if (!(robot_radius >= 0.0)) throw InputError("--robot-radius", "must be zero or positive");
   if (values.count("wall-thickness")) render_options.wall_thickness = values["wall-thickness"].as<double>();
   render_options.door_width = door_width;
 
@@ -95,22 +99,27 @@ int run(int argc, char** argv) {
   const OccupancyGrid map = loadMap(map_path);
   const Pose2 world_from_map = fitWorldFromMap(truth.poses, estimate.poses);
   const Pose2 start = truth.poses.front().pose;
-  const cv::Mat1b reachable = reachableFreeArea(rendered.map, Point2(start.x, start.y));
+  const cv::Mat1b reachable = reachableFreeArea(rendered.map, Point2(start.x, start.y), robot_radius);
   const MapQuality quality = evaluateMap(map, world_from_map, rendered.map, reachable);
+  const MapQuality all_free = evaluateMap(map, world_from_map, rendered.map, reachableFreeArea(rendered.map, Point2(start.x, start.y)));
   const cv::Mat1w true_rooms = trueRoomsInMap(environment, door_indices, spaceLabelsInMap(rendered, map, world_from_map));
   saveLabelImage(true_rooms, (out / "true_rooms.png").string());
 
-  const double coverage =
-      quality.true_free_cells ? double(quality.intersection_cells) / double(quality.true_free_cells) : 0.0;
+  const auto coverageOf = [](const MapQuality& q) {
+    return q.true_free_cells ? double(q.intersection_cells) / double(q.true_free_cells) : 0.0;
+  };
+  const double coverage = coverageOf(quality);
   const cv::Mat1f wall_distance = distanceToOccupied(map);
   std::ostringstream report;
   report << std::fixed << std::setprecision(4);
   report << "# translate_doors: the run against its world (world frame = the environment's)\n"
          << "world_from_map: [" << world_from_map.x << ", " << world_from_map.y << ", " << world_from_map.yaw << "]\n"
-         << "coverage: " << coverage
-         << "  # mapped free / reachable free (true free cells reachable from the start)\n"
-         << "free_iou: " << quality.free_iou << "\n"
-         << "walls_within_2_cells: " << quality.walls_within_2_cells << "\n"
+         << "coverage: " << coverage << "  # mapped free / true free cells the robot's body can reach from the start\n"
+         << "coverage_all_free: " << coverageOf(all_free)
+         << "  # mapped free / true free cells 4-connected to the start (also behind gaps narrower than the robot)\n"
+         << "robot_radius: " << robot_radius << "\n"
+         << "free_iou: " << all_free.free_iou << "\n"
+         << "walls_within_2_cells: " << all_free.walls_within_2_cells << "\n"
          << "path_length: " << pathLength(truth.poses) << "  # metres, true trajectory\n"
          << "duration: " << truth.poses.back().time - truth.poses.front().time << "  # seconds of the run's clock\n"
          << "doors:\n";
@@ -133,8 +142,8 @@ int run(int argc, char** argv) {
   }
   writeTextAtomically((out / "exploration.yaml").string(), report.str(), "exploration report");
   std::cout << "translate_doors: coverage " << std::fixed << std::setprecision(3)
-            << coverage
-            << ", free IoU " << quality.free_iou << ", worst door error " << worst_error << " m -> "
+            << coverage << " (all free cells " << coverageOf(all_free) << ")"
+            << ", free IoU " << all_free.free_iou << ", worst door error " << worst_error << " m -> "
             << (out / "exploration.yaml").string() << std::endl;
   return kExitOk;
 }
