@@ -23,6 +23,7 @@
 #include "hidden_rooms/environment.h"
 #include "hidden_rooms/render.h"
 #include "hidden_rooms/ros/conversions.h"
+#include "ros_test_util.h"
 
 namespace hidden_rooms {
 namespace {
@@ -76,18 +77,13 @@ class ExplorerFaultsTest : public ::testing::Test {
   // Spins, publishing the map every simulated second while it is alive, until `condition` or the wall timeout.
   template <typename Condition>
   bool waitFor(Condition condition, double wall_seconds) {
-    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(wall_seconds);
-    while (ros::WallTime::now() < deadline) {
-      ros::spinOnce();
+    return testing::spinUntil(condition, wall_seconds, [this] {
       const ros::Time now = ros::Time::now();
       if (map_alive_ && !now.isZero() && (last_map_.isZero() || (now - last_map_).toSec() >= 1.0)) {
         map_publisher_.publish(toRos(map_, "map", now));
         last_map_ = now;
       }
-      if (condition()) return true;
-      ros::WallDuration(0.005).sleep();
-    }
-    return false;
+    });
   }
   bool waitUntilSimTime(double time, double wall_seconds) {
     return waitFor([&] { return ros::Time::now().toSec() >= time; }, wall_seconds);

@@ -22,6 +22,7 @@
 #include "hidden_rooms/render.h"
 #include "hidden_rooms/ros/conversions.h"
 #include "hidden_rooms/wander_driver.h"
+#include "ros_test_util.h"
 #include "test_util.h"
 
 namespace hidden_rooms {
@@ -53,13 +54,7 @@ class MapperTest : public ::testing::Test {
 
   template <typename Condition>
   bool waitFor(Condition condition, double wall_seconds) {
-    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(wall_seconds);
-    while (ros::WallTime::now() < deadline) {
-      ros::spinOnce();
-      if (condition()) return true;
-      ros::WallDuration(0.005).sleep();
-    }
-    return false;
+    return testing::spinUntil(condition, wall_seconds);
   }
 
   double truthTime() const { return truth_.empty() ? 0.0 : truth_.back()->header.stamp.toSec(); }

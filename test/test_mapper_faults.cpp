@@ -25,6 +25,7 @@
 #include "hidden_rooms/occupancy_grid.h"
 #include "hidden_rooms/ros/conversions.h"
 #include "hidden_rooms/wander_driver.h"
+#include "ros_test_util.h"
 #include "test_util.h"
 
 namespace hidden_rooms {
@@ -108,13 +109,7 @@ class MapperFaultsTest : public ::testing::Test {
 
   template <typename Condition>
   bool waitFor(Condition condition, double wall_seconds) {
-    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(wall_seconds);
-    while (ros::WallTime::now() < deadline) {
-      ros::spinOnce();
-      if (condition()) return true;
-      ros::WallDuration(0.005).sleep();
-    }
-    return false;
+    return testing::spinUntil(condition, wall_seconds);
   }
 
   double lastRelayedTime() const { return relayed_.empty() ? 0.0 : relayed_.back()->header.stamp.toSec(); }

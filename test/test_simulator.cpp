@@ -13,6 +13,8 @@
 #include <sensor_msgs/LaserScan.h>
 #include <std_srvs/Trigger.h>
 
+#include "ros_test_util.h"
+
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
@@ -37,14 +39,9 @@ class SimulatorTest : public ::testing::Test {
 
   template <typename Condition>
   bool waitFor(Condition condition, double wall_seconds, const geometry_msgs::Twist* command = nullptr) {
-    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(wall_seconds);
-    while (ros::WallTime::now() < deadline) {
+    return hidden_rooms::testing::spinUntil(condition, wall_seconds, [&] {
       if (command != nullptr) command_publisher_.publish(*command);
-      ros::spinOnce();
-      if (condition()) return true;
-      ros::WallDuration(0.01).sleep();
-    }
-    return false;
+    }, 0.01);
   }
 
   // Publishes `linear` m/s for `seconds` of simulated time (ground-truth stamps).
