@@ -31,13 +31,17 @@
 //
 // Every room, grown or rectangle (not on turned maps), is then clipped to the known map's outline beside it
 // (clipToKnownOutline, default_outline_reach): a room does not stick out of the building past the outer walls
-// its neighbours show; a side where nothing is known beyond the door is left open.
+// its neighbours show; a side where nothing is known beyond the door is left open. Last, every room leaves out
+// the unknown cells within default_wall_margin of a wall cell: a wall the robot saw from one side shows only its
+// near face in a SLAM map, and the rest of its thickness is no room's. A negative margin (the default) is
+// estimated from the map (unseenWallThickness): 0 on maps that draw whole walls.
 //
 // Parameters: start_search_radius and the default_* keys (config/prediction.yaml), and the layout's
 // (config/layout.yaml) for the grown rooms; --debug-dir receives the layout's images.
 // terms: "rectangle" (1 when the rectangle was chosen, 0 the grown room); a grown room has the thesis's terms, a
 // rectangle "width", "depth" (metres), "depth_bounded" (1 when the depth came from the map, 0 from a prior) and
-// "rotation" (degrees the map was turned); every room "outline_clipped" (m^2 removed by the outline clip).
+// "rotation" (degrees the map was turned); every room "outline_clipped" (m^2 removed by the outline clip) and,
+// with a margin, "wall_margin" (metres) and "wall_margin_cut" (m^2 removed by it).
 
 #include <map>
 #include <string>
@@ -57,6 +61,13 @@ class DefaultPredictor : public RoomPredictor {
 // Dominant wall direction of a map, radians in [-pi/4, pi/4): the walls run along this angle and the one
 // perpendicular to it (image frame: x = column, y = row). 0 when the map has no occupied cells.
 double dominantWallAngle(const OccupancyGrid& map);
+
+// How much of the thickness of walls seen from one side a map does not show, metres: the most common length
+// (3 pixels to 1 m) of the runs along rows and columns that cross a wall seen from both sides (from a free cell,
+// starting and ending on an occupied cell, to the next free cell; the wall's inside may be unknown) less the median
+// occupied run between a free and an unknown cell (a wall seen from one side). 0 when the map draws whole walls,
+// or has fewer than 20 runs of either kind.
+double unseenWallThickness(const OccupancyGrid& map);
 
 // Clips a room (mask, image frame) to the known map's extent beside it: x to the known pixels of the rows within
 // `reach` pixels of the room's rows, y likewise from its columns, so that a room does not stick out of the

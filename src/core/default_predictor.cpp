@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <map>
 
 #include <opencv2/imgproc.hpp>
 
@@ -26,16 +27,18 @@ constexpr double kMinRotation = 1.0;         // degrees: smaller dominant angles
 constexpr double kGrownAreaRatio = 1.25;     // grown rooms less than this many times the rectangle give way
 constexpr double kStubLength = 0.3;          // m: wall stubs this long into the explored side end a room's extent
 constexpr double kOutlineReach = 15.0;       // m: band beside a room within which the known map's extent bounds it
+constexpr double kWallMargin = -1.0;         // m: unseen wall thickness left out of rooms; < 0: estimated from the map
 
-// Working states of a pixel.
+// Working states of a pixel; map values at or above kOccupiedFrom are walls.
 constexpr uint8_t kUnknownPx = 0, kFreePx = 1, kOccupiedPx = 2;
+constexpr int8_t kOccupiedFrom = 50;
 
 cv::Mat1b statesOf(const OccupancyGrid& map) {
   cv::Mat1b states(map.cells.size(), kUnknownPx);
   for (int r = 0; r < map.height(); ++r)
     for (int c = 0; c < map.width(); ++c) {
       const int8_t v = map.cells(r, c);
-      if (v >= 50) states(r, c) = kOccupiedPx;
+      if (v >= kOccupiedFrom) states(r, c) = kOccupiedPx;
       else if (v >= 0) states(r, c) = kFreePx;
     }
   return states;
@@ -43,7 +46,7 @@ cv::Mat1b statesOf(const OccupancyGrid& map) {
 
 struct Parameters {
   double start_search_radius, wall_gap, max_extent, bounded_fraction, neighbour_reach, min_depth, min_rotation;
-  double grown_area_ratio, stub_length, outline_reach;
+  double grown_area_ratio, stub_length, outline_reach, wall_margin;
 };
 
 // A door in the working image: centre pixel, wall axis a and normal n (unit axis vectors, n into the unknown).
@@ -79,6 +82,49 @@ class Frame {
 int median(std::vector<int> values) {
   std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
   return values[values.size() / 2];
+}
+
+// Unseen wall thickness in pixels (see unseenWallThickness in the header).
+int unseenWallPixels(const cv::Mat1b& states, int max_run) {
+  constexpr int kMinWallRun = 3;  // pixels: shorter runs between free pixels are specks and ragged wall faces
+  std::vector<int> through, one_sided;
+  const auto scan = [&](auto state_at, int lines, int length) {
+    for (int line = 0; line < lines; ++line) {
+      int begin = 0;
+      while (begin < length) {
+        if (state_at(line, begin) == kFreePx) {
+          ++begin;
+          continue;
+        }
+        int end = begin;  // the non-free run [begin, end)
+        while (end < length && state_at(line, end) != kFreePx) ++end;
+        const int run = end - begin;
+        const bool free_before = begin > 0, free_after = end < length;
+        if (free_before && free_after) {
+          if (run >= kMinWallRun && run <= max_run && state_at(line, begin) == kOccupiedPx &&
+              state_at(line, end - 1) == kOccupiedPx)
+            through.push_back(run);  // a wall seen from both sides (its inside may be unknown)
+        } else if (free_before || free_after) {
+          // A wall seen from the free side only: its occupied cells, followed by unknown ones.
+          int occupied = 0;
+          const int step = free_before ? 1 : -1, first = free_before ? begin : end - 1;
+          while (occupied < run && state_at(line, first + step * occupied) == kOccupiedPx) ++occupied;
+          if (occupied > 0 && occupied < run) one_sided.push_back(occupied);
+        }
+        begin = end;
+      }
+    }
+  };
+  scan([&](int r, int c) { return states(r, c); }, states.rows, states.cols);
+  scan([&](int c, int r) { return states(r, c); }, states.cols, states.rows);
+  if (through.size() < 20 || one_sided.size() < 20) return 0;
+  // The most common thickness: walls crossed at an angle give longer runs, which a median or quantile would follow.
+  std::map<int, int> counts;
+  for (int run : through) ++counts[run];
+  const int typical = std::max_element(counts.begin(), counts.end(), [](const auto& a, const auto& b) {
+                        return a.second < b.second;
+                      })->first;
+  return std::max(0, typical - median(one_sided));
 }
 
 // Unknown fraction of the strip behind the door (width of the door, `depth` pixels) on side n.
@@ -358,13 +404,18 @@ double dominantWallAngle(const OccupancyGrid& map) {
   return angle;
 }
 
+double unseenWallThickness(const OccupancyGrid& map) {
+  return unseenWallPixels(statesOf(map), static_cast<int>(1.0 / map.resolution)) * map.resolution;
+}
+
 std::map<std::string, double> DefaultPredictor::defaultParameters() const {
   std::map<std::string, double> parameters = layoutParameters(LayoutOptions());  // for the grown rooms
   parameters.insert({{"start_search_radius", kStartSearchRadius}, {"default_wall_gap", kWallGap},
                      {"default_max_extent", kMaxExtent},          {"default_bounded_fraction", kBoundedFraction},
                      {"default_neighbour_reach", kNeighbourReach}, {"default_min_depth", kMinDepth},
                      {"default_min_rotation", kMinRotation},       {"default_grown_area_ratio", kGrownAreaRatio},
-                     {"default_stub_length", kStubLength},         {"default_outline_reach", kOutlineReach}});
+                     {"default_stub_length", kStubLength},         {"default_outline_reach", kOutlineReach},
+                     {"default_wall_margin", kWallMargin}});
   return parameters;
 }
 
@@ -604,10 +655,11 @@ PredictionResult DefaultPredictor::predict(const PredictionRequest& request) con
                      values.at("default_max_extent"),      values.at("default_bounded_fraction"),
                      values.at("default_neighbour_reach"), values.at("default_min_depth"),
                      values.at("default_min_rotation"),    values.at("default_grown_area_ratio"),
-                     values.at("default_stub_length"),     values.at("default_outline_reach")};
+                     values.at("default_stub_length"),     values.at("default_outline_reach"),
+                     values.at("default_wall_margin")};
   if (P.start_search_radius <= 0.0 || P.wall_gap < 0.0 || P.max_extent <= 0.0 || P.neighbour_reach < 0.0 ||
       P.min_depth < 0.0 || P.min_rotation < 0.0 || P.bounded_fraction < 0.0 || P.bounded_fraction > 1.0 ||
-      P.grown_area_ratio < 0.0 || P.stub_length < 0.0 || P.outline_reach < 0.0)
+      P.grown_area_ratio < 0.0 || P.stub_length < 0.0 || P.outline_reach < 0.0 || std::isnan(P.wall_margin))
     throw InputError("parameters", "default_* parameters out of range");
 
   const double angle = dominantWallAngle(request.map);
@@ -634,6 +686,14 @@ PredictionResult DefaultPredictor::predict(const PredictionRequest& request) con
   }
   const cv::Mat1b known = request.map.cells != OccupancyGrid::kUnknown;
   const double resolution = request.map.resolution;
+  // Cells within the wall margin of an occupied cell: the unseen rest of the walls the robot saw from one side.
+  const double wall_margin = P.wall_margin >= 0.0 ? P.wall_margin : unseenWallThickness(request.map);
+  cv::Mat1b wall_band;
+  if (wall_margin > 0.0) {
+    cv::Mat1f distance;
+    cv::distanceTransform(request.map.cells < kOccupiedFrom, distance, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+    wall_band = distance * resolution <= wall_margin;
+  }
   PredictionResult result;
   for (size_t i = 0; i < count; ++i) {
     RoomPrediction room = std::move(use_rectangle[i] ? rectangles[i] : grown[i]);
@@ -647,6 +707,13 @@ PredictionResult DefaultPredictor::predict(const PredictionRequest& request) con
                          static_cast<int>(std::lround(P.outline_reach / resolution)),
                          static_cast<int>(std::lround(P.min_depth / resolution)), &room.mask);
       room.terms["outline_clipped"] = (before - cv::countNonZero(room.mask)) * resolution * resolution;
+      finishPrediction(request.map, &room);
+    }
+    if (!wall_band.empty() && room.placed) {
+      const int before = cv::countNonZero(room.mask);
+      room.mask.setTo(0, wall_band);
+      room.terms["wall_margin"] = wall_margin;
+      room.terms["wall_margin_cut"] = (before - cv::countNonZero(room.mask)) * resolution * resolution;
       finishPrediction(request.map, &room);
     }
     room.terms["rectangle"] = use_rectangle[i] ? 1.0 : 0.0;
