@@ -35,12 +35,8 @@ constexpr int8_t kOccupiedFrom = 50;
 
 cv::Mat1b statesOf(const OccupancyGrid& map) {
   cv::Mat1b states(map.cells.size(), kUnknownPx);
-  for (int r = 0; r < map.height(); ++r)
-    for (int c = 0; c < map.width(); ++c) {
-      const int8_t v = map.cells(r, c);
-      if (v >= kOccupiedFrom) states(r, c) = kOccupiedPx;
-      else if (v >= 0) states(r, c) = kFreePx;
-    }
+  states.setTo(kFreePx, map.cells >= 0);
+  states.setTo(kOccupiedPx, map.cells >= kOccupiedFrom);
   return states;
 }
 
@@ -364,17 +360,22 @@ void clipToKnownOutline(const cv::Mat1b& known, const cv::Point& door, int reach
 }
 
 double dominantWallAngle(const OccupancyGrid& map) {
-  cv::Mat1f occupied(map.cells.size(), 0.0f);
-  for (int r = 0; r < map.height(); ++r)
-    for (int c = 0; c < map.width(); ++c) occupied(r, c) = map.cells(r, c) >= 50 ? 1.0f : 0.0f;
+  // Only around the occupied cells (the blur and the gradients vanish 20 pixels away from them).
+  const cv::Mat1b occupied_cells = map.cells >= kOccupiedFrom;
+  const cv::Rect around = cv::boundingRect(occupied_cells);
+  if (around.area() == 0) return 0.0;
+  const cv::Rect crop = cv::Rect(around.x - 20, around.y - 20, around.width + 40, around.height + 40) &
+                        cv::Rect(0, 0, map.width(), map.height());
+  cv::Mat1f occupied;
+  occupied_cells(crop).convertTo(occupied, CV_32F, 1.0 / 255.0);
   cv::GaussianBlur(occupied, occupied, cv::Size(0, 0), 2.5);
   cv::Mat1f gx, gy;
   cv::Sobel(occupied, gx, CV_32F, 1, 0, 5);
   cv::Sobel(occupied, gy, CV_32F, 0, 1, 5);
   constexpr int kBins = 180;  // half-degree bins over 90 degrees
   std::vector<double> histogram(kBins, 0.0);
-  for (int r = 0; r < map.height(); ++r)
-    for (int c = 0; c < map.width(); ++c) {
+  for (int r = 0; r < occupied.rows; ++r)
+    for (int c = 0; c < occupied.cols; ++c) {
       const double x = gx(r, c), y = gy(r, c);
       const double magnitude = std::hypot(x, y);
       if (magnitude < 1e-3) continue;
@@ -690,9 +691,22 @@ PredictionResult DefaultPredictor::predict(const PredictionRequest& request) con
   const double wall_margin = P.wall_margin >= 0.0 ? P.wall_margin : unseenWallThickness(request.map);
   cv::Mat1b wall_band;
   if (wall_margin > 0.0) {
-    cv::Mat1f distance;
-    cv::distanceTransform(request.map.cells < kOccupiedFrom, distance, cv::DIST_L2, cv::DIST_MASK_PRECISE);
-    wall_band = distance * resolution <= wall_margin;
+    // Computed around the rooms only, with a margin beyond them so that their cells get their true distances.
+    cv::Rect rooms_box;
+    for (size_t i = 0; i < count; ++i) {
+      const RoomPrediction& room = use_rectangle[i] ? rectangles[i] : grown[i];
+      if (room.placed) rooms_box |= cv::boundingRect(room.mask);
+    }
+    const int reach = static_cast<int>(std::ceil(wall_margin / resolution)) + 2;
+    const cv::Rect box = cv::Rect(rooms_box.x - reach, rooms_box.y - reach, rooms_box.width + 2 * reach,
+                                  rooms_box.height + 2 * reach) &
+                         cv::Rect(0, 0, request.map.width(), request.map.height());
+    wall_band = cv::Mat1b::zeros(request.map.cells.size());
+    if (rooms_box.area() > 0 && box.area() > 0) {
+      cv::Mat1f distance;
+      cv::distanceTransform(request.map.cells(box) < kOccupiedFrom, distance, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+      wall_band(box).setTo(255, distance * resolution <= wall_margin);
+    }
   }
   PredictionResult result;
   for (size_t i = 0; i < count; ++i) {
