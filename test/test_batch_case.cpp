@@ -5,7 +5,6 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
-#include <thread>
 
 #include <opencv2/imgproc.hpp>
 
@@ -134,10 +133,7 @@ TEST(BatchCasesTool, PrintsOneJsonLinePerCaseAndFailsClearly) {
 // complete (equal to an uninterrupted run's), and a re-run completes the folder without any temporary left over.
 TEST(BatchCasesTool, SigkillLeavesNoPartialCaseFiles) {
   const std::string dir = testing::makeTempDir("batch_cases_sigkill");
-  const auto read = [](const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  };
+  const auto read = testing::readFile;
   const auto run = [&](const std::string& out) {
     return testing::startProcess({kBatchCases, std::string(HIDDEN_ROOMS_SOURCE_DIR) + "/worlds/medium_1.xml",
                                   "--sequence", "1,2,3,4,5,6", "--methods", "unstructured", "--write-cases", out},
@@ -152,20 +148,16 @@ TEST(BatchCasesTool, SigkillLeavesNoPartialCaseFiles) {
   const std::vector<std::string> files{"doors.yaml", "map.pgm", "map.yaml", "true_rooms.png"};
 
   const std::string out = dir + "/out";
-  int killed = 0;
   constexpr int kAttempts = 16;
-  for (int attempt = 0; attempt < kAttempts; ++attempt) {
-    const int pid = run(out);
-    std::this_thread::sleep_for(std::chrono::duration<double>(seconds * (attempt + 0.5) / kAttempts));
-    killed += testing::killProcess(pid);
-    if (!std::filesystem::is_directory(out)) continue;
+  const int killed = testing::killSpreadOver([&] { return run(out); }, seconds, kAttempts, [&](int attempt) {
+    if (!std::filesystem::is_directory(out)) return;
     for (const std::string& case_dir : testing::fileNames(out))
       for (const std::string& name : testing::fileNames(out + "/" + case_dir)) {
         if (name.find(".partial") != std::string::npos) continue;  // the killed writer's temporary
         EXPECT_EQ(read(out + "/" + case_dir + "/" + name), read(dir + "/reference/" + case_dir + "/" + name))
             << "attempt " << attempt << ": " << case_dir << "/" << name << " is not complete";
       }
-  }
+  });
   std::printf("%d of %d runs killed (run %.2f s)\n", killed, kAttempts, seconds);
   EXPECT_GE(killed, kAttempts / 4) << "too few runs were still running when killed";
 

@@ -6,7 +6,6 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
-#include <thread>
 
 #include <opencv2/imgcodecs.hpp>
 
@@ -146,11 +145,6 @@ TEST(PredictRoomsOfflineTool, WritesRoomsCompletedMapAndMetrics) {
   EXPECT_DOUBLE_EQ(metrics["rooms"][1]["iou"].as<double>(), 0.0);
 }
 
-std::string readBytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-}
-
 // rooms.yaml without its first lines (the computation time differs between runs).
 std::string roomsPart(const std::string& rooms_yaml) {
   const size_t at = rooms_yaml.find("\nrooms:");
@@ -174,25 +168,23 @@ TEST(PredictRoomsOfflineTool, SigkillLeavesNoPartialOutputAndTheRerunCompletes) 
   double seconds = 1e9;  // the fastest of three runs: the kills are spread over it
   for (int k = 0; k < 3; ++k) {
     const auto start = std::chrono::steady_clock::now();
-    ASSERT_EQ(testing::waitProcess(run(dir + "/reference")), 0) << readBytes(dir + "/log.txt");
+    ASSERT_EQ(testing::waitProcess(run(dir + "/reference")), 0) << testing::readFile(dir + "/log.txt");
     seconds = std::min(seconds, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   }
   const std::vector<std::string> outputs{"map.pgm", "map.yaml", "metrics.yaml", "overlay.png", "rooms.png", "rooms.yaml"};
   ASSERT_EQ(testing::fileNames(dir + "/reference"), outputs);
 
   const std::string out = dir + "/out";
-  int killed = 0, cut_while_writing = 0;
+  int cut_while_writing = 0;
   constexpr int kAttempts = 16;
-  for (int attempt = 0; attempt < kAttempts; ++attempt) {
-    const int pid = run(out);
-    std::this_thread::sleep_for(std::chrono::duration<double>(seconds * (attempt + 0.5) / kAttempts));
-    killed += testing::killProcess(pid);
-    if (!std::filesystem::is_directory(out)) continue;
+  const int killed = testing::killSpreadOver([&] { return run(out); }, seconds, kAttempts, [&](int attempt) {
+    if (!std::filesystem::is_directory(out)) return;
     int complete = 0;
     for (const std::string& name : testing::fileNames(out)) {
       if (name.find(".partial") != std::string::npos) continue;  // the killed writer's temporary
       ASSERT_NE(std::find(outputs.begin(), outputs.end(), name), outputs.end()) << name;
-      const std::string expected = readBytes(dir + "/reference/" + name), written = readBytes(out + "/" + name);
+      const std::string expected = testing::readFile(dir + "/reference/" + name);
+      const std::string written = testing::readFile(out + "/" + name);
       if (name == "rooms.yaml") {
         EXPECT_EQ(roomsPart(written), roomsPart(expected)) << "attempt " << attempt << ": " << name;
       } else {
@@ -201,16 +193,16 @@ TEST(PredictRoomsOfflineTool, SigkillLeavesNoPartialOutputAndTheRerunCompletes) 
       ++complete;
     }
     cut_while_writing += complete > 0 && complete < static_cast<int>(outputs.size());
-  }
+  });
   std::printf("%d of %d runs killed (run %.2f s), %d with some outputs written\n", killed, kAttempts, seconds,
               cut_while_writing);
   EXPECT_GE(killed, kAttempts / 4) << "too few runs were still running when killed";
 
-  ASSERT_EQ(testing::waitProcess(run(out)), 0) << readBytes(dir + "/log.txt");
+  ASSERT_EQ(testing::waitProcess(run(out)), 0) << testing::readFile(dir + "/log.txt");
   EXPECT_EQ(testing::fileNames(out), outputs);  // no temporary left
   for (const std::string& name : outputs) {
     if (name == "rooms.yaml") continue;
-    EXPECT_EQ(readBytes(out + "/" + name), readBytes(dir + "/reference/" + name)) << name;
+    EXPECT_EQ(testing::readFile(out + "/" + name), testing::readFile(dir + "/reference/" + name)) << name;
   }
 }
 

@@ -27,11 +27,6 @@ double figure(const std::string& output, const std::string& key) {
   return std::nan("");
 }
 
-std::string readFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-}
-
 class MapFromBag : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
@@ -55,9 +50,9 @@ TEST_F(MapFromBag, MapsTheShortBagWithinThresholds) {
   EXPECT_GE(figure(result.output, "walls_within_2_cells"), 0.80);  // measured 0.84 (a hard short run)
   EXPECT_LT(figure(result.output, "trajectory_rmse_m"), 0.2);
   EXPECT_GT(figure(result.output, "speed_factor"), 1.0);  // the 5x target is measured by the benchmark, not here
-  EXPECT_FALSE(readFile(dir_ + "/a.pgm").empty());
-  EXPECT_NE(readFile(dir_ + "/a.yaml").find("resolution: 0.05"), std::string::npos);
-  EXPECT_GE(figure(readFile(dir_ + "/metrics.yaml"), "free_iou"), 0.85);
+  EXPECT_FALSE(testing::readFile(dir_ + "/a.pgm").empty());
+  EXPECT_NE(testing::readFile(dir_ + "/a.yaml").find("resolution: 0.05"), std::string::npos);
+  EXPECT_GE(figure(testing::readFile(dir_ + "/metrics.yaml"), "free_iou"), 0.85);
 }
 
 // The same bag and seed give the same map, also when a run was killed with SIGKILL mid-way and run again: the
@@ -74,9 +69,9 @@ TEST_F(MapFromBag, SameBagAndSeedGiveTheSameMapAlsoAfterASigkill) {
                                         dir_ + "/killed.log");
   ASSERT_GT(pid, 0);
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-  while (readFile(dir_ + "/killed.log").find("% ") == std::string::npos && std::chrono::steady_clock::now() < deadline)
+  while (testing::readFile(dir_ + "/killed.log").find("% ") == std::string::npos && std::chrono::steady_clock::now() < deadline)
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  ASSERT_TRUE(testing::killProcess(pid)) << "map_from_bag ended before it was killed:\n" << readFile(dir_ + "/killed.log");
+  ASSERT_TRUE(testing::killProcess(pid)) << "map_from_bag ended before it was killed:\n" << testing::readFile(dir_ + "/killed.log");
   EXPECT_TRUE(testing::fileNames(killed_dir).empty()) << "the killed run left files";
 
   // What a kill during a write leaves: a temporary of a writer that no longer runs.
@@ -84,9 +79,9 @@ TEST_F(MapFromBag, SameBagAndSeedGiveTheSameMapAlsoAfterASigkill) {
   result = testing::runCommand(tool + " " + dir_ + "/run.bag --quiet --seed 5 --out " + killed_dir + "/s2");
   ASSERT_EQ(result.exit_code, 0) << result.output;
   EXPECT_EQ(testing::fileNames(killed_dir), (std::vector<std::string>{"s2.pgm", "s2.yaml"}));
-  EXPECT_EQ(readFile(dir_ + "/s1.pgm"), readFile(killed_dir + "/s2.pgm"));
-  EXPECT_EQ(readFile(dir_ + "/s1.yaml").substr(readFile(dir_ + "/s1.yaml").find("resolution")),
-            readFile(killed_dir + "/s2.yaml").substr(readFile(killed_dir + "/s2.yaml").find("resolution")));
+  EXPECT_EQ(testing::readFile(dir_ + "/s1.pgm"), testing::readFile(killed_dir + "/s2.pgm"));
+  EXPECT_EQ(testing::readFile(dir_ + "/s1.yaml").substr(testing::readFile(dir_ + "/s1.yaml").find("resolution")),
+            testing::readFile(killed_dir + "/s2.yaml").substr(testing::readFile(killed_dir + "/s2.yaml").find("resolution")));
 }
 
 TEST_F(MapFromBag, BadInputGivesAClearErrorAndExitCode2) {

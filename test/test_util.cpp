@@ -1,6 +1,8 @@
 #include "test_util.h"
 
 #include <fstream>
+#include <thread>
+#include <chrono>
 #include <sstream>
 
 #include <opencv2/imgcodecs.hpp>
@@ -51,6 +53,23 @@ bool killProcess(int pid) {
   kill(pid, SIGKILL);  // a child that exits meanwhile stays a zombie until reaped: its pid is still its own
   waitpid(pid, &status, 0);
   return WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL;
+}
+
+std::string readFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+int killSpreadOver(const std::function<int()>& start, double seconds, int attempts,
+                   const std::function<void(int)>& after_kill) {
+  int killed = 0;
+  for (int attempt = 0; attempt < attempts; ++attempt) {
+    const int pid = start();
+    std::this_thread::sleep_for(std::chrono::duration<double>(seconds * (attempt + 0.5) / attempts));
+    killed += killProcess(pid);
+    after_kill(attempt);
+  }
+  return killed;
 }
 
 int waitProcess(int pid) {

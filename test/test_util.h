@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdlib>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -75,6 +76,12 @@ bool killProcess(int pid);
 int waitProcess(int pid);
 // The names of the files in `dir` (not recursive), sorted.
 std::vector<std::string> fileNames(const std::string& dir);
+// The whole content of a file (empty when it cannot be read).
+std::string readFile(const std::string& path);
+// Starts `attempts` runs with `start` (returns the child's pid) and SIGKILLs the k-th after (k + 0.5) / attempts of
+// `seconds`, calling `after_kill(k)` once it is dead; how many runs were still running when killed.
+int killSpreadOver(const std::function<int()>& start, double seconds, int attempts,
+                   const std::function<void(int)>& after_kill);
 
 // A tiny environment in the thesis schema (0.05 m per pixel): a 10 m x 2 m corridor (pixels x 0..200,
 // y 0..40) under two rooms, A (x 0..80, y 40..120) and B (x 80..200, y 40..120), each with one door to the
