@@ -3,6 +3,7 @@
 // Pieces shared by the prediction methods.
 
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -23,8 +24,10 @@ bool nearestUnknownCell(const OccupancyGrid& map, const Point2& position, double
                         std::string* problem);
 
 // Fills polygon (outer contour of the largest blob, map frame) and area (m²) of a prediction from its mask,
-// and sets placed = true; an empty mask makes it not placed with `problem` "no room predicted".
-void finishPrediction(const OccupancyGrid& map, RoomPrediction* room);
+// and sets placed = true; an empty mask makes it not placed with `problem` "no room predicted". When the caller
+// knows a rectangle holding every cell of the mask, `cells_within` spares the scan of the whole image.
+void finishPrediction(const OccupancyGrid& map, RoomPrediction* room,
+                      const std::optional<cv::Rect>& cells_within = std::nullopt);
 
 // The prediction of a door that could not be placed: empty mask of the map's size, placed = false, `problem`.
 RoomPrediction unplacedRoom(const OccupancyGrid& map, int door_id, const std::string& problem);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <future>
 #include <limits>
 #include <map>
 
@@ -354,9 +355,9 @@ void clipToKnownOutline(const cv::Mat1b& known, const cv::Point& door, int reach
   // Keep [x0, x1) x [y0, y1), each limit only when it lies at least min_depth beyond the door.
   const cv::Rect keep(cv::Point(door.x - x0 >= min_depth ? x0 : 0, door.y - y0 >= min_depth ? y0 : 0),
                       cv::Point(x1 - door.x >= min_depth ? x1 : known.cols, y1 - door.y >= min_depth ? y1 : known.rows));
-  cv::Mat1b outside(mask->size(), 255);
-  outside(keep & image).setTo(0);
-  mask->setTo(0, outside);
+  cv::Mat1b outside(room.size(), 255);
+  outside((keep & room) - room.tl()).setTo(0);
+  (*mask)(room).setTo(0, outside);
 }
 
 double dominantWallAngle(const OccupancyGrid& map) {
@@ -372,18 +373,21 @@ double dominantWallAngle(const OccupancyGrid& map) {
   cv::Mat1f gx, gy;
   cv::Sobel(occupied, gx, CV_32F, 1, 0, 5);
   cv::Sobel(occupied, gy, CV_32F, 0, 1, 5);
+  cv::Mat1f magnitude, direction;  // direction in [0, 2 pi)
+  cv::cartToPolar(gx, gy, magnitude, direction);
   constexpr int kBins = 180;  // half-degree bins over 90 degrees
   std::vector<double> histogram(kBins, 0.0);
-  for (int r = 0; r < occupied.rows; ++r)
+  for (int r = 0; r < occupied.rows; ++r) {
+    const float* m = magnitude.ptr<float>(r);
+    const float* d = direction.ptr<float>(r);
     for (int c = 0; c < occupied.cols; ++c) {
-      const double x = gx(r, c), y = gy(r, c);
-      const double magnitude = std::hypot(x, y);
-      if (magnitude < 1e-3) continue;
-      double angle = std::atan2(y, x);  // gradient direction; walls run perpendicular: same modulo 90 degrees
-      angle = std::fmod(angle + 4.0 * CV_PI, CV_PI / 2.0);
-      const int bin = std::min(kBins - 1, static_cast<int>(angle / (CV_PI / 2.0) * kBins));
-      histogram[bin] += magnitude;
+      if (m[c] < 1e-3f) continue;
+      // Gradient direction; walls run perpendicular to it: the same modulo 90 degrees.
+      const double angle = std::fmod(static_cast<double>(d[c]), CV_PI / 2.0);
+      const int bin = std::clamp(static_cast<int>(angle / (CV_PI / 2.0) * kBins), 0, kBins - 1);
+      histogram[bin] += m[c];
     }
+  }
   int best = 0;
   double best_value = -1.0;
   for (int b = 0; b < kBins; ++b) {
@@ -423,14 +427,15 @@ std::map<std::string, double> DefaultPredictor::defaultParameters() const {
 namespace {
 
 // The wall-fitted rectangle of every door (steps 1 to 3 of the header), in the map's frame; `angle` is the map's
-// dominantWallAngle.
-std::vector<RoomPrediction> rectangleRooms(const PredictionRequest& request, const Parameters& P, double angle) {
+// dominantWallAngle, `map_states` its statesOf.
+std::vector<RoomPrediction> rectangleRooms(const PredictionRequest& request, const Parameters& P, double angle,
+                                           const cv::Mat1b& map_states) {
   const OccupancyGrid& map = request.map;
   const double resolution = map.resolution;
 
   // 1. Orientation.
   const bool rotate = std::abs(angle) * 180.0 / CV_PI >= P.min_rotation;
-  cv::Mat1b states = statesOf(map);
+  cv::Mat1b states = map_states;
   cv::Matx23d forward(1, 0, 0, 0, 1, 0);
   cv::Size work_size = states.size();
   if (rotate) {
@@ -447,14 +452,7 @@ std::vector<RoomPrediction> rectangleRooms(const PredictionRequest& request, con
                    cv::Scalar(kUnknownPx));
     states = rotated;
   }
-  cv::Rect box;
-  {
-    cv::Mat1b known = states != kUnknownPx;
-    std::vector<cv::Point> points;
-    cv::findNonZero(known, points);
-    box = cv::boundingRect(points);
-  }
-  const Frame f(states, box);
+  const Frame f(states, cv::boundingRect(states != kUnknownPx));
 
   // 2. Doors.
   const size_t count = request.doors.doors.size();
@@ -604,33 +602,39 @@ std::vector<RoomPrediction> rectangleRooms(const PredictionRequest& request, con
   }
   for (size_t i = 0; i < count; ++i) {
     if (!doors[i].ok || masks[i].empty()) continue;
-    masks[i].setTo(0, owner != static_cast<short>(i));
+    // A room's pixels lie in its rectangle: the work below stays there.
+    const cv::Rect rect = rects[i] & cv::Rect(0, 0, work_size.width, work_size.height);
+    cv::Mat1b in_rect = masks[i](rect);
+    in_rect.setTo(0, owner(rect) != static_cast<short>(i));
     // Keep what is connected to the door.
     const cv::Point seed = f.at(doors[i], 0, doors[i].s0);
-    if (!f.inside(seed) || !masks[i](seed)) {
+    if (!rect.contains(seed) || !masks[i](seed)) {
       // The door's own column may be claimed by another room: keep the largest part instead.
       continue;
     }
-    cv::Mat1b flood = cv::Mat1b::zeros(work_size.height + 2, work_size.width + 2);
-    cv::floodFill(masks[i], flood, seed, 255, nullptr, 0, 0, 4 | cv::FLOODFILL_MASK_ONLY | (255 << 8));
-    masks[i] = flood(cv::Rect(1, 1, work_size.width, work_size.height)).clone();
+    cv::Mat1b flood = cv::Mat1b::zeros(rect.height + 2, rect.width + 2);
+    cv::floodFill(in_rect, flood, seed - rect.tl(), 255, nullptr, 0, 0, 4 | cv::FLOODFILL_MASK_ONLY | (255 << 8));
+    flood(cv::Rect(1, 1, rect.width, rect.height)).copyTo(in_rect);
   }
 
   // Back to the map's frame.
   std::vector<RoomPrediction> rooms;
-  const cv::Mat1b map_unknown = map.cells == OccupancyGrid::kUnknown;
+  const cv::Mat1b map_known = map.cells != OccupancyGrid::kUnknown;
   for (size_t i = 0; i < count; ++i) {
     RoomPrediction room;
     room.door_id = request.doors.doors[i].id;
     room.problem = doors[i].problem;
+    // Where the room's cells lie: its rectangle, or anywhere on a turned map.
+    cv::Rect cells_within(0, 0, map.width(), map.height());
     if (doors[i].ok && !masks[i].empty()) {
       if (rotate) {
         cv::warpAffine(masks[i], room.mask, cv::Mat(forward), map.cells.size(),
                        cv::INTER_NEAREST | cv::WARP_INVERSE_MAP, cv::BORDER_CONSTANT, cv::Scalar(0));
       } else {
         room.mask = masks[i];
+        cells_within &= rects[i];
       }
-      room.mask.setTo(0, ~map_unknown);
+      room.mask(cells_within).setTo(0, map_known(cells_within));
       room.terms["width"] = (doors[i].right - doors[i].left + 1) * resolution;
       room.terms["depth"] = doors[i].depth * resolution;
       room.terms["depth_bounded"] = doors[i].bounded ? 1.0 : 0.0;
@@ -640,7 +644,7 @@ std::vector<RoomPrediction> rectangleRooms(const PredictionRequest& request, con
     } else {
       room.mask = cv::Mat1b::zeros(map.cells.size());
     }
-    finishPrediction(map, &room);
+    finishPrediction(map, &room, cells_within);
     rooms.push_back(std::move(room));
   }
   return rooms;
@@ -663,40 +667,50 @@ PredictionResult DefaultPredictor::predict(const PredictionRequest& request) con
       P.grown_area_ratio < 0.0 || P.stub_length < 0.0 || P.outline_reach < 0.0 || std::isnan(P.wall_margin))
     throw InputError("parameters", "default_* parameters out of range");
 
-  const double angle = dominantWallAngle(request.map);
-  std::vector<RoomPrediction> rectangles = rectangleRooms(request, P, angle);
-  // The layout's cells are axis-aligned: on a turned map only the rectangles (built on the map turned straight).
-  const bool turned = std::abs(angle) * 180.0 / CV_PI >= P.min_rotation;
-  // The grown rooms: the thesis's growth with its own constants on the layout this request configures.
+  // The grown rooms: the thesis's growth with its own constants on the layout this request configures. It does
+  // not depend on the rectangles, so it runs on a second thread meanwhile.
   PredictionRequest grown_request;
   grown_request.map = request.map;
   grown_request.doors = request.doors;
   grown_request.debug_dir = request.debug_dir;
   for (const std::string& name : layoutParameterNames()) grown_request.parameters[name] = values.at(name);
-  std::vector<RoomPrediction> grown =
-      turned ? std::vector<RoomPrediction>(rectangles.size()) : ThesisPredictor().predict(grown_request).rooms;
+  std::future<PredictionResult> growth =
+      std::async(std::launch::async, [&grown_request] { return ThesisPredictor().predict(grown_request); });
+
+  const double angle = dominantWallAngle(request.map);
+  const cv::Mat1b states = statesOf(request.map);
+  std::vector<RoomPrediction> rectangles = rectangleRooms(request, P, angle, states);
+  const cv::Mat1b known = request.map.cells != OccupancyGrid::kUnknown;
+  const double resolution = request.map.resolution;
+  // Cells within the wall margin of an occupied cell: the unseen rest of the walls the robot saw from one side.
+  const double wall_margin =
+      P.wall_margin >= 0.0 ? P.wall_margin
+                           : unseenWallPixels(states, static_cast<int>(1.0 / resolution)) * resolution;
+
+  // The layout's cells are axis-aligned: on a turned map only the rectangles (built on the map turned straight),
+  // and the growth's result (or error) is dropped.
+  const bool turned = std::abs(angle) * 180.0 / CV_PI >= P.min_rotation;
+  std::vector<RoomPrediction> grown(rectangles.size());
+  if (turned) growth.wait();
+  else grown = growth.get().rooms;
 
   // Per door: the grown room, unless it is much smaller than the rectangle (it stopped short of the walls the
   // rectangle found) or missing; a rectangle gives up the pixels of the grown rooms kept for other doors.
   const size_t count = rectangles.size();
   std::vector<bool> use_rectangle(count, false);
+  std::vector<cv::Rect> boxes(count);  // bounding box of each chosen room: every later step only removes cells
   cv::Mat1b kept_grown = cv::Mat1b::zeros(request.map.cells.size());
   for (size_t i = 0; i < count; ++i) {
     use_rectangle[i] = turned || (rectangles[i].placed && grown[i].area < P.grown_area_ratio * rectangles[i].area);
-    if (!use_rectangle[i] && grown[i].placed) kept_grown |= grown[i].mask;
+    const RoomPrediction& room = use_rectangle[i] ? rectangles[i] : grown[i];
+    if (room.placed) boxes[i] = cv::boundingRect(room.mask);
+    if (!use_rectangle[i] && grown[i].placed) kept_grown(boxes[i]) |= grown[i].mask(boxes[i]);
   }
-  const cv::Mat1b known = request.map.cells != OccupancyGrid::kUnknown;
-  const double resolution = request.map.resolution;
-  // Cells within the wall margin of an occupied cell: the unseen rest of the walls the robot saw from one side.
-  const double wall_margin = P.wall_margin >= 0.0 ? P.wall_margin : unseenWallThickness(request.map);
   cv::Mat1b wall_band;
   if (wall_margin > 0.0) {
     // Computed around the rooms only, with a margin beyond them so that their cells get their true distances.
     cv::Rect rooms_box;
-    for (size_t i = 0; i < count; ++i) {
-      const RoomPrediction& room = use_rectangle[i] ? rectangles[i] : grown[i];
-      if (room.placed) rooms_box |= cv::boundingRect(room.mask);
-    }
+    for (const cv::Rect& box : boxes) rooms_box |= box;
     const int reach = static_cast<int>(std::ceil(wall_margin / resolution)) + 2;
     const cv::Rect box = cv::Rect(rooms_box.x - reach, rooms_box.y - reach, rooms_box.width + 2 * reach,
                                   rooms_box.height + 2 * reach) &
@@ -711,24 +725,26 @@ PredictionResult DefaultPredictor::predict(const PredictionRequest& request) con
   PredictionResult result;
   for (size_t i = 0; i < count; ++i) {
     RoomPrediction room = std::move(use_rectangle[i] ? rectangles[i] : grown[i]);
+    const cv::Rect& box = boxes[i];
+    const auto cells = [&] { return cv::countNonZero(room.mask(box)); };
     if (use_rectangle[i]) {
-      room.mask.setTo(0, kept_grown);
-      finishPrediction(request.map, &room);
+      room.mask(box).setTo(0, kept_grown(box));
+      finishPrediction(request.map, &room, box);
     }
     if (!turned && P.outline_reach > 0.0 && room.placed) {
-      const int before = cv::countNonZero(room.mask);
+      const int before = cells();
       clipToKnownOutline(known, doorPixel(request.map, request.doors.doors[i]),
                          static_cast<int>(std::lround(P.outline_reach / resolution)),
                          static_cast<int>(std::lround(P.min_depth / resolution)), &room.mask);
-      room.terms["outline_clipped"] = (before - cv::countNonZero(room.mask)) * resolution * resolution;
-      finishPrediction(request.map, &room);
+      room.terms["outline_clipped"] = (before - cells()) * resolution * resolution;
+      finishPrediction(request.map, &room, box);
     }
     if (!wall_band.empty() && room.placed) {
-      const int before = cv::countNonZero(room.mask);
-      room.mask.setTo(0, wall_band);
+      const int before = cells();
+      room.mask(box).setTo(0, wall_band(box));
       room.terms["wall_margin"] = wall_margin;
-      room.terms["wall_margin_cut"] = (before - cv::countNonZero(room.mask)) * resolution * resolution;
-      finishPrediction(request.map, &room);
+      room.terms["wall_margin_cut"] = (before - cells()) * resolution * resolution;
+      finishPrediction(request.map, &room, box);
     }
     room.terms["rectangle"] = use_rectangle[i] ? 1.0 : 0.0;
     result.rooms.push_back(std::move(room));

@@ -144,6 +144,9 @@ bool writePngRows(std::FILE* file, const PngRows& image, char* error) {
   }
   png_init_io(png, file);
   png_set_compression_level(png, 1);  // fast, like OpenCV's default: maps compress well anyway
+  // One filter for every row instead of libpng's per-row trial of all five: map, label and overlay images
+  // repeat their rows, so "up" is 2-3 times faster than the trial at about the same size.
+  png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_UP);
   png_set_IHDR(png, info, image.width, image.height, image.bit_depth, image.colour_type, PNG_INTERLACE_NONE,
                PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
   png_write_info(png, info);

@@ -14,9 +14,7 @@
 namespace hidden_rooms {
 
 cv::Rect knownBoundingBox(const OccupancyGrid& map) {
-  std::vector<cv::Point> known;
-  cv::findNonZero(map.cells != OccupancyGrid::kUnknown, known);
-  return known.empty() ? cv::Rect() : cv::boundingRect(known);
+  return cv::boundingRect(map.cells != OccupancyGrid::kUnknown);
 }
 
 bool nearestUnknownCell(const OccupancyGrid& map, const Point2& position, double max_distance, cv::Point* cell,
@@ -45,9 +43,14 @@ bool nearestUnknownCell(const OccupancyGrid& map, const Point2& position, double
   return true;
 }
 
-void finishPrediction(const OccupancyGrid& map, RoomPrediction* room) {
+void finishPrediction(const OccupancyGrid& map, RoomPrediction* room, const std::optional<cv::Rect>& cells_within) {
   // The room's bounding box and one more pixel around it (where it is inside the image): all the work below.
-  const cv::Rect box = room->mask.empty() ? cv::Rect() : cv::boundingRect(room->mask);
+  cv::Rect box;
+  if (!room->mask.empty()) {
+    const cv::Rect within = cells_within ? *cells_within & cv::Rect(0, 0, room->mask.cols, room->mask.rows)
+                                         : cv::Rect(0, 0, room->mask.cols, room->mask.rows);
+    box = cv::boundingRect(room->mask(within)) + within.tl();
+  }
   const cv::Rect roi = cv::Rect(box.x - 1, box.y - 1, box.width + 2, box.height + 2) &
                        cv::Rect(0, 0, room->mask.cols, room->mask.rows);
   const int cells = box.area() == 0 ? 0 : cv::countNonZero(room->mask(roi));
@@ -150,19 +153,21 @@ OccupancyGrid insertRooms(const OccupancyGrid& map, const DoorsFile& doors, cons
 
 cv::Mat1w roomLabels(const OccupancyGrid& map, const DoorsFile& doors, const std::vector<RoomPrediction>& rooms) {
   cv::Mat1w labels = cv::Mat1w::zeros(map.cells.size());
-  cv::Mat1f door_distance(map.cells.size(), std::numeric_limits<float>::infinity());
+  const auto door_distance = [&](const cv::Point& cell, size_t k) {
+    return static_cast<float>((map.cellCentre(cell.x, cell.y) - doors.doors[k].position).norm());
+  };
   for (size_t k = 0; k < rooms.size() && k < doors.doors.size(); ++k) {
     if (!rooms[k].placed) continue;
-    // Only the mask's bounding box is scanned: rooms are small against the map.
+    // Only the mask's bounding box is scanned: rooms are small against the map. Distances are needed only
+    // where an earlier room already claimed the cell.
     const cv::Rect box = cv::boundingRect(rooms[k].mask);
-    std::vector<cv::Point> cells;
-    if (box.area() > 0) cv::findNonZero(rooms[k].mask(box), cells);
-    for (cv::Point cell : cells) {
-      cell += box.tl();
-      const float distance = static_cast<float>((map.cellCentre(cell.x, cell.y) - doors.doors[k].position).norm());
-      if (distance < door_distance(cell)) {
-        door_distance(cell) = distance;
-        labels(cell) = static_cast<uint16_t>(k + 1);
+    for (int row = box.y; row < box.br().y; ++row) {
+      const uint8_t* in_room = rooms[k].mask.ptr<uint8_t>(row);
+      uint16_t* label = labels.ptr<uint16_t>(row);
+      for (int col = box.x; col < box.br().x; ++col) {
+        if (!in_room[col]) continue;
+        if (label[col] == 0 || door_distance({col, row}, k) < door_distance({col, row}, label[col] - 1))
+          label[col] = static_cast<uint16_t>(k + 1);
       }
     }
   }
@@ -179,23 +184,39 @@ cv::Mat3b renderPredictionOverlay(const OccupancyGrid& map, const cv::Mat1w& pre
                                   const cv::Mat& true_labels) {
   cv::Mat3b overlay;
   cv::cvtColor(map.toGreyImage(), overlay, cv::COLOR_GRAY2BGR);
+  // Rooms tinted in one pass: 40 % map grey, 60 % the room's colour.
   double max_label = 0.0;
   cv::minMaxLoc(predicted_labels, nullptr, &max_label);
-  for (int label = 1; label <= static_cast<int>(max_label); ++label) {
-    const cv::Mat1b room = predicted_labels == label;
-    if (cv::countNonZero(room) == 0) continue;
-    cv::Mat3b tinted;
-    cv::addWeighted(overlay, 0.4, cv::Mat3b(overlay.size(), roomColour(label)), 0.6, 0.0, tinted);
-    tinted.copyTo(overlay, room);
+  std::vector<cv::Vec3b> colours(static_cast<size_t>(max_label) + 1);
+  for (size_t label = 1; label < colours.size(); ++label) colours[label] = roomColour(static_cast<int>(label));
+  for (int row = 0; row < overlay.rows; ++row) {
+    const uint16_t* label = predicted_labels.ptr<uint16_t>(row);
+    cv::Vec3b* pixel = overlay.ptr<cv::Vec3b>(row);
+    for (int col = 0; col < overlay.cols; ++col) {
+      if (label[col] == 0) continue;
+      for (int channel = 0; channel < 3; ++channel)
+        pixel[col][channel] = cv::saturate_cast<uchar>(0.4 * pixel[col][channel] + 0.6 * colours[label[col]][channel]);
+    }
   }
   if (!true_labels.empty()) {
     cv::Mat1i truth;
     true_labels.convertTo(truth, CV_32S);
+    // Each true room outlined within its own bounding box (one pixel wider, so that the contour is closed).
     double max_truth = 0.0;
     cv::minMaxLoc(truth, nullptr, &max_truth);
-    for (int label = 1; label <= static_cast<int>(max_truth); ++label) {
+    std::vector<cv::Rect> boxes(static_cast<size_t>(std::max(0.0, max_truth)) + 1);
+    for (int row = 0; row < truth.rows; ++row) {
+      const int* label = truth.ptr<int>(row);
+      for (int col = 0; col < truth.cols; ++col)
+        if (label[col] > 0) boxes[static_cast<size_t>(label[col])] |= cv::Rect(col, row, 1, 1);
+    }
+    const cv::Rect image(0, 0, truth.cols, truth.rows);
+    for (int label = 1; label < static_cast<int>(boxes.size()); ++label) {
+      const cv::Rect& box = boxes[static_cast<size_t>(label)];
+      if (box.empty()) continue;
+      const cv::Rect roi = cv::Rect(box.x - 1, box.y - 1, box.width + 2, box.height + 2) & image;
       std::vector<std::vector<cv::Point>> contours;
-      cv::findContours(cv::Mat1b(truth == label), contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_SIMPLE);
+      cv::findContours(cv::Mat1b(truth(roi) == label), contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_SIMPLE, roi.tl());
       cv::drawContours(overlay, contours, -1, cv::Scalar(0, 160, 0), 2);
     }
   }
