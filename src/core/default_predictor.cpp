@@ -367,25 +367,36 @@ double dominantWallAngle(const OccupancyGrid& map) {
   if (around.area() == 0) return 0.0;
   const cv::Rect crop = cv::Rect(around.x - 20, around.y - 20, around.width + 40, around.height + 40) &
                         cv::Rect(0, 0, map.width(), map.height());
-  cv::Mat1f occupied;
-  occupied_cells(crop).convertTo(occupied, CV_32F, 1.0 / 255.0);
-  cv::GaussianBlur(occupied, occupied, cv::Size(0, 0), 2.5);
-  cv::Mat1f gx, gy;
-  cv::Sobel(occupied, gx, CV_32F, 1, 0, 5);
-  cv::Sobel(occupied, gy, CV_32F, 0, 1, 5);
-  cv::Mat1f magnitude, direction;  // direction in [0, 2 pi)
-  cv::cartToPolar(gx, gy, magnitude, direction);
+  // Gradient directions, weighted by their magnitude, into a histogram modulo 90 degrees (walls run perpendicular
+  // to their gradients). The image is worked through in strips of rows, each with enough rows of context on both
+  // sides for the blur and the Sobel kernels, so that the working images stay small: the same values as on the
+  // whole image at once.
+  constexpr double kBlurSigma = 2.5;
+  constexpr int kSobelSize = 5;
+  constexpr int kStripRows = 64;
+  const int context = static_cast<int>(std::lround(4 * kBlurSigma)) + kSobelSize / 2 + 2;
   constexpr int kBins = 180;  // half-degree bins over 90 degrees
   std::vector<double> histogram(kBins, 0.0);
-  for (int r = 0; r < occupied.rows; ++r) {
-    const float* m = magnitude.ptr<float>(r);
-    const float* d = direction.ptr<float>(r);
-    for (int c = 0; c < occupied.cols; ++c) {
-      if (m[c] < 1e-3f) continue;
-      // Gradient direction; walls run perpendicular to it: the same modulo 90 degrees.
-      const double angle = std::fmod(static_cast<double>(d[c]), CV_PI / 2.0);
-      const int bin = std::clamp(static_cast<int>(angle / (CV_PI / 2.0) * kBins), 0, kBins - 1);
-      histogram[bin] += m[c];
+  const cv::Mat1b cells = occupied_cells(crop);
+  cv::Mat1f occupied, gx, gy, magnitude, direction;  // direction in [0, 2 pi)
+  for (int top = 0; top < cells.rows; top += kStripRows) {
+    const int bottom = std::min(cells.rows, top + kStripRows);
+    const int first = std::max(0, top - context), last = std::min(cells.rows, bottom + context);
+    cells.rowRange(first, last).convertTo(occupied, CV_32F, 1.0 / 255.0);
+    cv::GaussianBlur(occupied, occupied, cv::Size(0, 0), kBlurSigma);
+    cv::Sobel(occupied, gx, CV_32F, 1, 0, kSobelSize);
+    cv::Sobel(occupied, gy, CV_32F, 0, 1, kSobelSize);
+    const cv::Range strip(top - first, bottom - first);
+    cv::cartToPolar(gx.rowRange(strip), gy.rowRange(strip), magnitude, direction);
+    for (int r = 0; r < magnitude.rows; ++r) {
+      const float* m = magnitude.ptr<float>(r);
+      const float* d = direction.ptr<float>(r);
+      for (int c = 0; c < magnitude.cols; ++c) {
+        if (m[c] < 1e-3f) continue;
+        const double angle = std::fmod(static_cast<double>(d[c]), CV_PI / 2.0);
+        const int bin = std::clamp(static_cast<int>(angle / (CV_PI / 2.0) * kBins), 0, kBins - 1);
+        histogram[bin] += m[c];
+      }
     }
   }
   int best = 0;
