@@ -5,7 +5,8 @@
 // its default parameters) when that room is at least default_grown_area_ratio times the rectangle (the
 // rectangle stopped short, e.g. of an L-shaped room) or the rectangle is missing. A rectangle gives up
 // the pixels of the grown rooms kept for the other doors. On a map whose dominant wall angle is at least
-// default_min_rotation (the layout's cells are axis-aligned) every door gets its rectangle.
+// default_min_rotation (the layout's cells are axis-aligned) every door gets its rectangle. The growth runs on a
+// second thread while the rectangles are fitted (predict() is still safe to call from several threads).
 //
 // The rectangles:
 // 1. Orientation: the dominant wall direction (modulo 90 degrees) from the gradient directions of the occupied
