@@ -32,8 +32,9 @@ def main():
     parser.add_argument("--method", default="default")
     parser.add_argument("--repeats", type=int, default=20)
     args = parser.parse_args()
-    map_yaml = os.path.join(args.case_dir, "map.yaml")
-    doors_yaml = os.path.join(args.case_dir, "doors.yaml")
+    # Absolute paths: roslaunch starts the nodes in ROS_HOME, not here.
+    map_yaml = os.path.abspath(os.path.join(args.case_dir, "map.yaml"))
+    doors_yaml = os.path.abspath(os.path.join(args.case_dir, "doors.yaml"))
     for path in (map_yaml, doors_yaml):
         if not os.path.isfile(path):
             sys.exit("time_predict_service: %s: not found" % path)
