@@ -30,8 +30,9 @@ catkin_make --build build_fuzz -DCATKIN_DEVEL_PREFIX="$WS/devel_fuzz" -DHIDDEN_R
   -j"$(nproc)" "${TARGETS[@]/#/fuzz_}" > "$FUZZ/build.log" 2>&1 || { tail -30 "$FUZZ/build.log"; exit 1; }
 
 # Seeds: the kept inputs, then real files of each kind.
-seed() {  # seed TARGET FILE...
+seed() {  # seed TARGET FILE... (nothing when TARGET is not fuzzed this time)
   local dir="$FUZZ/corpus/$1"; shift
+  [ -d "$dir" ] || return 0
   for file in "$@"; do [ -f "$file" ] && cp "$file" "$dir/seed_$(basename "$(dirname "$file")")_$(basename "$file")"; done
   return 0
 }
@@ -43,20 +44,26 @@ seed environment_xml "$ROOT"/worlds/*.xml $(ls "$SHARED"/environments/*/*.xml 2>
 seed doors_yaml $(ls "$SHARED"/closed_door_benchmark/*/*/doors.yaml 2>/dev/null | head -10)
 seed parameter_file "$ROOT/config/prediction.yaml" "$ROOT/config/layout.yaml"
 seed image $(ls "$SHARED"/closed_door_benchmark/*/*/gt_rooms.png 2>/dev/null | head -3)
-if [ -d "$FUZZ/corpus/map_yaml" ]; then  # "yaml \0 image" pairs from rendered worlds
+# Rendered small worlds: "yaml \0 image" pairs, their images and their OctoMaps ("\0" + a .bt).
+if [ -d "$FUZZ/corpus/map_yaml" ] || [ -d "$FUZZ/corpus/image" ] || [ -d "$FUZZ/corpus/octomap" ]; then
   for world in "$ROOT"/worlds/small_*.xml; do
-    out="$FUZZ/render_$(basename "$world" .xml)"
+    name="$(basename "$world" .xml)"
+    out="$FUZZ/render_$name"
     rosrun hidden_rooms render_environment "$world" --out "$out" --resolution 0.2 > /dev/null
-    { sed 's/^image: .*/image: map.img/' "$out/map.yaml"; printf '\0'; cat "$out/map.pgm"; } \
-      > "$FUZZ/corpus/map_yaml/seed_$(basename "$world" .xml)"
-    cp "$out/map.pgm" "$FUZZ/corpus/image/seed_$(basename "$world" .xml).pgm" 2>/dev/null || true
+    if [ -d "$FUZZ/corpus/map_yaml" ]; then
+      { sed 's/^image: .*/image: map.img/' "$out/map.yaml"; printf '\0'; cat "$out/map.pgm"; } \
+        > "$FUZZ/corpus/map_yaml/seed_$name"
+    fi
+    seed image "$out/map.pgm"
     if [ -d "$FUZZ/corpus/octomap" ]; then
-      rosrun hidden_rooms export_octomap "$out/map.yaml" --out "$out/map.bt" --height 0.6 > /dev/null 2>&1
-      { printf '\0'; cat "$out/map.bt"; } > "$FUZZ/corpus/octomap/seed_$(basename "$world" .xml)_bt"
+      rosrun hidden_rooms export_octomap "$out/map.yaml" --out "$out/map.bt" --height 0.6 > /dev/null
+      { printf '\0'; cat "$out/map.bt"; } > "$FUZZ/corpus/octomap/seed_${name}_bt"
     fi
   done
 fi
-printf '# frame: map -> base_link\n0.1000 1.0 2.0 0.5\n0.2000 1.1 2.0 0.6\n' > "$FUZZ/corpus/pose_log/seed_log" 2>/dev/null || true
+if [ -d "$FUZZ/corpus/pose_log" ]; then
+  printf '# frame: map -> base_link\n0.1000 1.0 2.0 0.5\n0.2000 1.1 2.0 0.6\n' > "$FUZZ/corpus/pose_log/seed_log"
+fi
 
 failed=0
 printf '%-16s %12s %8s %s\n' target executions seconds result
@@ -64,7 +71,9 @@ for target in "${TARGETS[@]}"; do
   log="$FUZZ/$target.log"
   start=$(date +%s)
   status=0
-  (cd "$FUZZ" && "$WS/devel_fuzz/lib/hidden_rooms/fuzz_$target" "$FUZZ/corpus/$target" \
+  # The instrumented core library, not the main build's that devel/setup.bash puts on LD_LIBRARY_PATH.
+  (cd "$FUZZ" && LD_LIBRARY_PATH="$WS/devel_fuzz/lib:${LD_LIBRARY_PATH:-}" \
+     "$WS/devel_fuzz/lib/hidden_rooms/fuzz_$target" "$FUZZ/corpus/$target" \
      -max_total_time="$SECONDS_PER_TARGET" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
      -close_fd_mask=1 -artifact_prefix="$FUZZ/artifacts/$target/" > "$log" 2>&1) || status=$?
   executions=$(grep -aoP 'stat::number_of_executed_units:\s*\K[0-9]+' "$log" || echo "?")

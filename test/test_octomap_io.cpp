@@ -2,9 +2,11 @@
 // prediction on a sliced map, bad input.
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 
 #include <gtest/gtest.h>
 #include <octomap/ColorOcTree.h>
+#include <octomap/OcTree.h>
 #include <opencv2/imgproc.hpp>
 
 #include "hidden_rooms/input_error.h"
@@ -171,6 +173,57 @@ TEST(OctomapIo, BadInputGivesClearErrors) {
   EXPECT_THROW(exportOctomap(map, cv::Mat1w(), flat, dir + "/map.bt"), InputError);
   EXPECT_THROW(exportOctomap(OccupancyGrid(), cv::Mat1w(), ExtrusionOptions(), dir + "/map.bt"), InputError);
   EXPECT_THROW(exportOctomap(map, cv::Mat1w(), ExtrusionOptions(), dir + "/no/such/folder/map.bt"), InputError);
+}
+
+// OctoMap's readers follow a file's child bits past its end and to any depth (the fuzzer's out-of-memory input
+// is kept in test/fuzz/regressions/octomap): such files are refused before OctoMap reads them.
+TEST(OctomapIo, DamagedTreesAreRefusedBeforeOctomapReadsThem) {
+  const std::string dir = testing::makeTempDir("octomap_damaged");
+  OccupancyGrid map;
+  DoorsFile doors;
+  cv::Mat1w truth;
+  testing::syntheticHiddenRoomA(&map, &doors, &truth);
+  const auto error = [](const std::string& path) {
+    try {
+      sliceOctomap(path, SliceOptions());
+    } catch (const InputError& refused) {
+      return std::string(refused.what());
+    }
+    return std::string("no error");
+  };
+  const auto write = [&](const std::string& name, const std::string& bytes) {
+    std::ofstream(dir + "/" + name, std::ios::binary) << bytes;
+    return dir + "/" + name;
+  };
+  for (const std::string extension : {".bt", ".ot"}) {
+    SCOPED_TRACE(extension);
+    exportOctomap(map, cv::Mat1w(), ExtrusionOptions(), dir + "/map" + extension);
+    std::ifstream file(dir + "/map" + extension, std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+    EXPECT_NE(error(write("cut" + extension, bytes.substr(0, bytes.size() - 7))).find("ends inside its tree"),
+              std::string::npos);
+    const size_t size_line = bytes.find("\nsize ");
+    const std::string miscounted =
+        bytes.substr(0, size_line) + "\nsize 3" + bytes.substr(bytes.find('\n', size_line + 1));
+    EXPECT_NE(error(write("miscounted" + extension, miscounted)).find("declares 3 nodes but holds"), std::string::npos);
+    // Trailing bytes are not part of the tree.
+    expectSameMap(sliceOctomap(write("trailing" + extension, bytes + "extra"), SliceOptions()), cropToKnown(map));
+  }
+  // A .ot whose every node has all eight children: 17 nodes reach below OctoMap's 16 levels.
+  std::string deep = "# Octomap OcTree file\nid OcTree\nsize 137\nres 0.1\ndata\n";
+  for (int level = 0; level <= 16; ++level) deep += std::string(4, '\0') + '\xff';
+  EXPECT_NE(error(write("deep.ot", deep)).find("deeper than OctoMap's 16 levels"), std::string::npos);
+  const std::string counting = "# Octomap OcTree file\nid CountingOcTree\nres 0.1\nsize 1\ndata\n";
+  EXPECT_NE(error(write("counting.ot", counting)).find("'CountingOcTree', not an OcTree"), std::string::npos);
+  // Two voxels 3 km apart: a grid of 4e9 cells is refused, a coarser one is sliced.
+  octomap::OcTree far(0.05);
+  far.updateNode(octomap::point3d(-1500.0, -1500.0, 0.5), true);
+  far.updateNode(octomap::point3d(1500.0, 1500.0, 0.5), true);
+  ASSERT_TRUE(far.writeBinary(dir + "/far.bt"));
+  EXPECT_NE(error(dir + "/far.bt").find("slice it at a coarser resolution"), std::string::npos);
+  SliceOptions coarse;
+  coarse.resolution = 1.0;
+  EXPECT_NEAR(sliceOctomap(dir + "/far.bt", coarse).width(), 3000, 1);
 }
 
 }  // namespace

@@ -81,9 +81,10 @@ int median(std::vector<int> values) {
   return values[values.size() / 2];
 }
 
-// Unseen wall thickness in pixels (see unseenWallThickness in the header).
-int unseenWallPixels(const cv::Mat1b& states, int max_run) {
+// Unseen wall thickness in metres of the map whose statesOf is `states` (see unseenWallThickness in the header).
+double unseenWallMetres(const cv::Mat1b& states, double resolution) {
   constexpr int kMinWallRun = 3;  // pixels: shorter runs between free pixels are specks and ragged wall faces
+  const int max_run = static_cast<int>(1.0 / resolution);  // walls are thinner than a metre
   std::vector<int> through, one_sided;
   const auto scan = [&](auto state_at, int lines, int length) {
     for (int line = 0; line < lines; ++line) {
@@ -114,14 +115,14 @@ int unseenWallPixels(const cv::Mat1b& states, int max_run) {
   };
   scan([&](int r, int c) { return states(r, c); }, states.rows, states.cols);
   scan([&](int c, int r) { return states(r, c); }, states.cols, states.rows);
-  if (through.size() < 20 || one_sided.size() < 20) return 0;
+  if (through.size() < 20 || one_sided.size() < 20) return 0.0;
   // The most common thickness: walls crossed at an angle give longer runs, which a median or quantile would follow.
   std::map<int, int> counts;
   for (int run : through) ++counts[run];
   const int typical = std::max_element(counts.begin(), counts.end(), [](const auto& a, const auto& b) {
                         return a.second < b.second;
                       })->first;
-  return std::max(0, typical - median(one_sided));
+  return std::max(0, typical - median(one_sided)) * resolution;
 }
 
 // Unknown fraction of the strip behind the door (width of the door, `depth` pixels) on side n.
@@ -420,9 +421,7 @@ double dominantWallAngle(const OccupancyGrid& map) {
   return angle;
 }
 
-double unseenWallThickness(const OccupancyGrid& map) {
-  return unseenWallPixels(statesOf(map), static_cast<int>(1.0 / map.resolution)) * map.resolution;
-}
+double unseenWallThickness(const OccupancyGrid& map) { return unseenWallMetres(statesOf(map), map.resolution); }
 
 std::map<std::string, double> DefaultPredictor::defaultParameters() const {
   std::map<std::string, double> parameters = layoutParameters(LayoutOptions());  // for the grown rooms
@@ -438,9 +437,9 @@ std::map<std::string, double> DefaultPredictor::defaultParameters() const {
 namespace {
 
 // The wall-fitted rectangle of every door (steps 1 to 3 of the header), in the map's frame; `angle` is the map's
-// dominantWallAngle, `map_states` its statesOf.
+// dominantWallAngle, `map_states` its statesOf and `map_known` its known cells (255).
 std::vector<RoomPrediction> rectangleRooms(const PredictionRequest& request, const Parameters& P, double angle,
-                                           const cv::Mat1b& map_states) {
+                                           const cv::Mat1b& map_states, const cv::Mat1b& map_known) {
   const OccupancyGrid& map = request.map;
   const double resolution = map.resolution;
 
@@ -630,7 +629,6 @@ std::vector<RoomPrediction> rectangleRooms(const PredictionRequest& request, con
 
   // Back to the map's frame.
   std::vector<RoomPrediction> rooms;
-  const cv::Mat1b map_known = map.cells != OccupancyGrid::kUnknown;
   for (size_t i = 0; i < count; ++i) {
     RoomPrediction room;
     room.door_id = request.doors.doors[i].id;
@@ -690,13 +688,11 @@ PredictionResult DefaultPredictor::predict(const PredictionRequest& request) con
 
   const double angle = dominantWallAngle(request.map);
   const cv::Mat1b states = statesOf(request.map);
-  std::vector<RoomPrediction> rectangles = rectangleRooms(request, P, angle, states);
   const cv::Mat1b known = request.map.cells != OccupancyGrid::kUnknown;
+  std::vector<RoomPrediction> rectangles = rectangleRooms(request, P, angle, states, known);
   const double resolution = request.map.resolution;
   // Cells within the wall margin of an occupied cell: the unseen rest of the walls the robot saw from one side.
-  const double wall_margin =
-      P.wall_margin >= 0.0 ? P.wall_margin
-                           : unseenWallPixels(states, static_cast<int>(1.0 / resolution)) * resolution;
+  const double wall_margin = P.wall_margin >= 0.0 ? P.wall_margin : unseenWallMetres(states, resolution);
 
   // The layout's cells are axis-aligned: on a turned map only the rectangles (built on the map turned straight),
   // and the growth's result (or error) is dropped.

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <iterator>
 #include <sstream>
 #include <memory>
 #include <type_traits>
@@ -24,6 +26,7 @@ namespace {
 constexpr int8_t kFreeMax = 19;      // map_saver's thresholds (percent)
 constexpr int8_t kOccupiedMin = 65;
 constexpr double kEdge = 0.01;      // cells: tolerance of leaf edges against cell edges
+constexpr double kMaxSliceCells = 1e8;
 const cv::Vec3b kWallGrey(90, 90, 90);
 const cv::Vec3b kFreeGrey(220, 220, 220);
 
@@ -84,8 +87,16 @@ OccupancyGrid slice(const Tree& tree, const SliceOptions& options, const std::st
   OccupancyGrid grid;
   grid.resolution = resolution;
   grid.origin = Point2(min_x, min_y);
-  const int width = std::max(1, static_cast<int>(std::ceil((max_x - min_x) / resolution - kEdge)));
-  const int height = std::max(1, static_cast<int>(std::ceil((max_y - min_y) / resolution - kEdge)));
+  const double columns = std::ceil((max_x - min_x) / resolution - kEdge);
+  const double rows = std::ceil((max_y - min_y) / resolution - kEdge);
+  if (!(columns * rows <= kMaxSliceCells)) {
+    std::ostringstream problem;
+    problem << "spans " << columns << " x " << rows << " cells at " << resolution
+            << " m (at most 1e8): slice it at a coarser resolution";
+    throw InputError(path, problem.str());
+  }
+  const int width = std::max(1, static_cast<int>(columns));
+  const int height = std::max(1, static_cast<int>(rows));
   grid.cells = cv::Mat_<int8_t>(height, width, OccupancyGrid::kUnknown);
   for (auto leaf = tree.begin_leafs(), end = tree.end_leafs(); leaf != end; ++leaf) {
     const double half = 0.5 * leaf.getSize();
@@ -110,35 +121,80 @@ OccupancyGrid slice(const Tree& tree, const SliceOptions& options, const std::st
   return grid;
 }
 
-// Reads the header OctoMap's readers trust ("id", "size", "res" lines up to "data") and refuses what would make
-// them allocate for nodes the file cannot hold: a .bt spends 2 bytes on every inner node for its 8 children (at
-// most 4.5 nodes per byte) and a .ot more, so a file declaring more than 8 nodes per remaining byte is damaged.
-void checkOctomapHeader(const std::string& path) {
+constexpr int kTreeDepth = 16;  // OctoMap's levels below the root: nodes at this depth are leaves
+
+// An OctoMap file checked before OctoMap reads it. OctoMap's readers trust the file: they follow the child bits
+// past its end (reading garbage) and to any depth, allocating without bound. So the header is parsed here, the
+// node structure walked within the file's bytes and OctoMap's depth, the node count compared with the header's,
+// and OctoMap reads the stream returned: a header written here followed by exactly the walked bytes.
+std::istringstream checkedOctomapStream(const std::string& path, bool binary) {
   std::ifstream file(path, std::ios::binary);
-  std::string line;
+  const std::string bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  if (file.bad()) throw InputError(path, "cannot be read");
+  const std::string first_line = binary ? "# Octomap OcTree binary file" : "# Octomap OcTree file";
+  if (bytes.compare(0, first_line.size(), first_line) != 0)
+    throw InputError(path, "is not an OctoMap file (the first line is not '" + first_line + "')");
+
+  // Header: "key value" lines and # comments up to a line "data".
+  std::string id;
   long long declared_nodes = -1;
   double resolution = 0.0;
-  bool data = false;
-  for (int lines = 0; lines < 100 && std::getline(file, line); ++lines) {
-    std::istringstream fields(line);
+  size_t data = std::string::npos;
+  size_t line_begin = bytes.find('\n');
+  while (line_begin != std::string::npos && ++line_begin < bytes.size()) {
+    const size_t line_end = std::min(bytes.find('\n', line_begin), bytes.size());
+    std::istringstream fields(bytes.substr(line_begin, line_end - line_begin));
     std::string key;
     fields >> key;
-    if (key == "size") fields >> declared_nodes;
-    if (key == "res") fields >> resolution;
     if (key == "data") {
-      data = true;
+      data = std::min(line_end + 1, bytes.size());
       break;
     }
+    if (key == "id") fields >> id;
+    if (key == "size") fields >> declared_nodes;
+    if (key == "res") fields >> resolution;
+    line_begin = line_end;
   }
-  if (!data) throw InputError(path, "is not an OctoMap file (no header ending in 'data')");
+  if (data == std::string::npos) throw InputError(path, "is not an OctoMap file (no header ending in 'data')");
   if (!(resolution > 0.0) || !std::isfinite(resolution))
     throw InputError(path, "declares a resolution that is not positive");
-  const std::streamoff header = file.tellg();
-  file.seekg(0, std::ios::end);
-  const long long remaining = static_cast<long long>(file.tellg() - header);
-  if (declared_nodes < 0 || declared_nodes > 8 * remaining)
-    throw InputError(path, "declares " + std::to_string(declared_nodes) + " nodes but holds only " +
-                               std::to_string(remaining) + " bytes of them");
+  if (id != "OcTree" && (binary || id != "ColorOcTree"))
+    throw InputError(path, "holds a tree of type '" + id + "', not an OcTree" + (binary ? "" : " or ColorOcTree"));
+
+  // The nodes, depth first: a .bt spends 2 bytes on each inner node (2 bits per child: 01 occupied leaf, 10 free
+  // leaf, 11 inner node); a .ot spends on each node its value (float log-odds, plus r, g, b for a ColorOcTree) and
+  // a byte of child bits.
+  const size_t node_bytes = binary ? 2 : (id == "ColorOcTree" ? 8 : 5);
+  size_t at = data;
+  long long nodes = 1;
+  const std::function<void(int)> walk = [&](int depth) {
+    if (bytes.size() - at < node_bytes)
+      throw InputError(path, "ends inside its tree (after " + std::to_string(nodes) + " nodes)");
+    const auto* node = reinterpret_cast<const unsigned char*>(bytes.data() + at);
+    at += node_bytes;
+    std::vector<bool> has_children;  // per present child
+    for (int child = 0; child < 8; ++child) {
+      if (binary) {
+        const int code = (node[child / 4] >> (2 * (child % 4))) & 3;
+        if (code != 0) has_children.push_back(code == 3);
+      } else if ((node[node_bytes - 1] >> child) & 1) {
+        has_children.push_back(true);
+      }
+    }
+    if (!has_children.empty() && depth == kTreeDepth)
+      throw InputError(path, "has nodes deeper than OctoMap's " + std::to_string(kTreeDepth) + " levels");
+    nodes += static_cast<long long>(has_children.size());
+    for (const bool inner : has_children)
+      if (inner) walk(depth + 1);
+  };
+  walk(0);
+  if (nodes != declared_nodes)
+    throw InputError(path, "declares " + std::to_string(declared_nodes) + " nodes but holds " + std::to_string(nodes));
+
+  std::ostringstream header;
+  header.precision(17);
+  header << first_line << "\nid " << id << "\nsize " << nodes << "\nres " << resolution << "\ndata\n";
+  return std::istringstream(header.str() + bytes.substr(data, at - data), std::ios::binary);
 }
 
 }  // namespace
@@ -207,14 +263,15 @@ OccupancyGrid sliceOctomap(const std::string& path, const SliceOptions& options)
     throw InputError("octomap slice", "the resolution must be positive (or 0 for the tree's)");
   if (!std::filesystem::is_regular_file(path)) throw InputError(path, "no such file");
   const std::string extension = extensionOf(path);
-  if (extension == ".bt" || extension == ".ot") checkOctomapHeader(path);
   if (extension == ".bt") {
+    std::istringstream stream = checkedOctomapStream(path, true);
     octomap::OcTree tree(0.1);
-    if (!tree.readBinary(path)) throw InputError(path, "is not a readable binary OctoMap (.bt)");
+    if (!tree.readBinary(stream)) throw InputError(path, "is not a readable binary OctoMap (.bt)");
     return slice(tree, options, path);
   }
   if (extension == ".ot") {
-    std::unique_ptr<octomap::AbstractOcTree> tree(octomap::AbstractOcTree::read(path));
+    std::istringstream stream = checkedOctomapStream(path, false);
+    std::unique_ptr<octomap::AbstractOcTree> tree(octomap::AbstractOcTree::read(stream));
     if (!tree) throw InputError(path, "is not a readable OctoMap (.ot)");
     if (const auto* color = dynamic_cast<const octomap::ColorOcTree*>(tree.get())) return slice(*color, options, path);
     if (const auto* plain = dynamic_cast<const octomap::OcTree*>(tree.get())) return slice(*plain, options, path);

@@ -315,7 +315,8 @@ def parse_arguments(argv):
     parser.add_argument("--timeout", type=float, default=120.0,
                         help="simulated seconds between saved maps (the thesis's timeout)")
     parser.add_argument("--growth", type=float, default=0.001,
-                        help="stop when a saved map has less than this fraction more free cells than the last")
+                        help="stop when a saved map has less than this fraction more free cells than the last "
+                             "(a negative value: never)")
     parser.add_argument("--max-time", type=float, default=1800.0, help="simulated seconds at most per world")
     parser.add_argument("--realtime-factor", type=float, default=4.0, help="simulated seconds per wall second")
     parser.add_argument("--seed", type=int, default=0, help="seed of the simulator and the filter")
