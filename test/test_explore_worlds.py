@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """scripts/explore_worlds end to end on test/simulator_corridor.xml (a corridor with two rooms) with door 1
 closed: its own ROS master, simulator + mapper + explorer + pose_logger until the explorer is done, then the
-saved map, the door translated into the map frame, the true room, the prediction and the summary; and bad input.
+saved map, the door translated into the map frame, the true room, the prediction and the summary; bad input; and
+the no_growth rule.
 
 Needs the built package (found like the scripts find it: $CMAKE_PREFIX_PATH, else the checkout's .ws) and
 roslaunch; skips without them, unless HIDDEN_ROOMS_REQUIRE_SHARED=1 (scripts/test.sh), when it fails.
@@ -21,6 +22,7 @@ import yaml
 PACKAGE_DIR = os.path.dirname(os.path.dirname(os.path.realpath(__file__)))
 sys.path.insert(0, os.path.join(PACKAGE_DIR, "src"))
 from hidden_rooms import package_tools  # noqa: E402
+from hidden_rooms.explore_worlds import GrowthStop  # noqa: E402
 
 SCRIPT = os.path.join(PACKAGE_DIR, "scripts", "explore_worlds")
 WORLD = os.path.join(PACKAGE_DIR, "test", "simulator_corridor.xml")
@@ -30,6 +32,18 @@ RUN_OPTIONS = ["--closed", "1", "--timeout", "10", "--growth", "-1", "--max-time
 
 def run(*arguments, timeout=600):
     return subprocess.run([sys.executable, SCRIPT] + list(arguments), capture_output=True, text=True, timeout=timeout)
+
+
+class GrowthStopTest(unittest.TestCase):
+    def test_stops_after_patience_maps_in_a_row_without_growth(self):
+        stop = GrowthStop(0.01, 2)
+        # 1000 -> 1005 (+0.5 %: flat) -> 1100 (grew: the count starts again) -> 1100 -> 1099: stop.
+        self.assertEqual([stop.update(free) for free in (1000, 1005, 1100, 1100, 1099)],
+                         [False, False, False, False, True])
+        thesis = GrowthStop(0.01, 1)
+        self.assertEqual([thesis.update(free) for free in (1000, 1005)], [False, True])
+        never = GrowthStop(-1, 1)
+        self.assertFalse(any(never.update(free) for free in (1000, 900, 0, 0)))
 
 
 class ExploreWorldsTest(unittest.TestCase):

@@ -2,10 +2,10 @@
 
 Per world, in its own ROS master on a free port (so several worlds run side by side): exploration_run.launch
 (simulator, mapper, explorer, pose_logger, optionally a bag recorder). Every --timeout seconds of simulated time
-the map is saved (DIR/WORLD/maps/map_NNN); the run stops when the explorer reports done, when a saved map grew
-by less than --growth over the one before, or at --max-time. Then the final map, the closed doors translated
-into the map frame (translate_doors, METHOD.md §2), the run's scores against its world and, with --method, the
-predicted rooms and their IoU are written. DIR/summary.csv has one row per world.
+the map is saved (DIR/WORLD/maps/map_NNN); the run stops when the explorer reports done, when --patience saved
+maps in a row each grew by less than --growth over the one before, or at --max-time. Then the final map, the
+closed doors translated into the map frame (translate_doors, METHOD.md §2), the run's scores against its world
+and, with --method, the predicted rooms and their IoU are written. DIR/summary.csv has one row per world.
 
 A re-run keeps the worlds already finished with the same settings (DIR/WORLD/result.json, written atomically)
 and runs the others again. Every child process gets SIGTERM when its parent dies, so a run killed even by SIGKILL
@@ -157,6 +157,21 @@ def stop_launch(launch):
             launch.wait()
 
 
+class GrowthStop:
+    """The no_growth rule: `update` takes the free cells of each saved map and is true once `patience` maps in a
+    row each had less than `growth` (a fraction) more than the map before."""
+
+    def __init__(self, growth, patience):
+        self.growth, self.patience = growth, patience
+        self.last_free, self.flat = None, 0
+
+    def update(self, free):
+        grew = not self.last_free or free - self.last_free >= self.growth * self.last_free
+        self.flat = 0 if grew else self.flat + 1
+        self.last_free = free
+        return self.flat >= self.patience
+
+
 def explore(args, out_dir, log):
     """Runs the launch until a stop criterion; returns (status, simulated seconds). Maps go to out_dir."""
     maps_dir = os.path.join(out_dir, "maps")
@@ -176,7 +191,8 @@ def explore(args, out_dir, log):
     try:
         wait_for_master(launch, time.monotonic() + MASTER_START_TIMEOUT)
         run = Run(world_name(args.world))
-        status, last_free, saved = None, None, 0
+        status, saved = None, 0
+        growth_stop = GrowthStop(args.growth, args.patience)
         next_save = args.timeout
         last_sim, last_progress = 0.0, time.monotonic()
         while status is None:
@@ -196,9 +212,9 @@ def explore(args, out_dir, log):
             elif now >= next_save:
                 saved += 1
                 free = run.save_map(os.path.join(maps_dir, "map_%03d" % saved))
-                if last_free and free - last_free < args.growth * last_free:
+                if growth_stop.update(free):
                     status = "no_growth"
-                last_free, next_save = free, next_save + args.timeout
+                next_save += args.timeout
         run.save_map(os.path.join(out_dir, "map"))
         return status, run.sim_time()
     finally:
@@ -315,8 +331,10 @@ def parse_arguments(argv):
     parser.add_argument("--timeout", type=float, default=120.0,
                         help="simulated seconds between saved maps (the thesis's timeout)")
     parser.add_argument("--growth", type=float, default=0.001,
-                        help="stop when a saved map has less than this fraction more free cells than the last "
-                             "(a negative value: never)")
+                        help="a saved map with less than this fraction more free cells than the last did not grow "
+                             "(a negative value: never stop for it)")
+    parser.add_argument("--patience", type=int, default=3,
+                        help="stop after this many saved maps in a row that did not grow (1 = the thesis's rule)")
     parser.add_argument("--max-time", type=float, default=1800.0, help="simulated seconds at most per world")
     parser.add_argument("--realtime-factor", type=float, default=4.0, help="simulated seconds per wall second")
     parser.add_argument("--seed", type=int, default=0, help="seed of the simulator and the filter")
@@ -329,6 +347,8 @@ def parse_arguments(argv):
     for name in ("timeout", "max_time", "realtime_factor"):
         if not getattr(args, name) > 0:
             parser.error("--%s must be positive" % name.replace("_", "-"))
+    if args.patience < 1:
+        parser.error("--patience must be at least 1")
     if args.jobs < 1:
         parser.error("--jobs must be at least 1")
     if args.closed.startswith("random:") and not (args.closed[len("random:"):].isdigit() and
@@ -340,6 +360,7 @@ def parse_arguments(argv):
 def worker_command(args, world, closed):
     command = [sys.executable, os.path.realpath(sys.argv[0]), world, "--worker", "--out", args.out,
                "--closed", closed, "--timeout", str(args.timeout), "--growth", str(args.growth),
+               "--patience", str(args.patience),
                "--max-time", str(args.max_time), "--realtime-factor", str(args.realtime_factor),
                "--seed", str(args.seed), "--method", args.method]
     return command + (["--bag"] if args.bag else []) + (["--gui"] if args.gui else [])
@@ -347,7 +368,8 @@ def worker_command(args, world, closed):
 
 def run_settings(args, closed):
     """What makes two runs of a world the same run (a finished one is kept on a re-run with these)."""
-    return {"closed": closed, "timeout": args.timeout, "growth": args.growth, "max_time": args.max_time,
+    return {"closed": closed, "timeout": args.timeout, "growth": args.growth, "patience": args.patience,
+            "max_time": args.max_time,
             "realtime_factor": args.realtime_factor, "seed": args.seed, "method": args.method, "bag": args.bag}
 
 
