@@ -290,6 +290,52 @@ TEST(PathFollower, CountsTheRecoveriesThatMovedNothing) {
   }
 }
 
+// A robot wedged diagonally in a passage turns free only one way: after a recovery that moved nothing the next
+// one (of this goal or the next, while the robot is still there) turns the other way; after one that moved the
+// robot, the laser picks the side again.
+TEST(PathFollower, ARecoveryThatMovedNothingMakesTheNextTurnTheOtherWay) {
+  PathFollowerOptions options;
+  options.max_recoveries = 2;
+  // The wall ahead leans to the left: the freer side is the right (a clockwise turn).
+  std::vector<Point2> wall = wallAhead(0.5 * options.footprint_length + 0.05);
+  for (double x = 0.0; x < 0.5; x += 0.02) wall.emplace_back(x, 0.35);
+  const Pose2 pinned{0.5, 0.0, 0.0};
+  // The turn direction of every recovery until the goal fails.
+  const auto recovery_turns = [&](PathFollower* follower, double* time) {
+    std::vector<double> turns;
+    FollowerStep step;
+    bool rotating = false;
+    for (; step.state != FollowerState::kFailed && *time < 200.0; *time += 0.1) {
+      step = follower->update(pinned, wall, *time);
+      const bool now_rotating = step.state == FollowerState::kRecoveryRotating;
+      if (now_rotating && !rotating) turns.push_back(step.command.angular > 0.0 ? 1.0 : -1.0);
+      rotating = now_rotating;
+    }
+    return turns;
+  };
+  PathFollower follower(options);
+  double time = 0.0;
+  follower.setPath(straightPath(5.0), time);
+  EXPECT_EQ(recovery_turns(&follower, &time), (std::vector<double>{-1.0, 1.0}));
+  follower.setPath(straightPath(5.0), time);  // the next goal, the robot still pinned
+  EXPECT_EQ(recovery_turns(&follower, &time), (std::vector<double>{-1.0, 1.0}));
+  // A robot that follows the commands: every recovery moves it, so the laser's side every time.
+  PathFollower free_follower(options);
+  Pose2 pose = pinned;
+  time = 0.0;
+  free_follower.setPath(straightPath(5.0), time);
+  std::vector<double> turns;
+  bool rotating = false;
+  for (; free_follower.recoveries() < 2 && time < 60.0; time += 0.1) {
+    const FollowerStep step = free_follower.update(pose, wall, time);
+    const bool now_rotating = step.state == FollowerState::kRecoveryRotating;
+    if (now_rotating && !rotating) turns.push_back(step.command.angular > 0.0 ? 1.0 : -1.0);
+    rotating = now_rotating;
+    pose.yaw += 0.1 * step.command.angular;  // turns, but the wall (in the robot frame) stays where it is
+  }
+  for (double turn : turns) EXPECT_EQ(turn, -1.0);
+}
+
 TEST(PathFollower, ObstaclePointsSkipInvalidReturnsAndApplyTheLaserPose) {
   RangeScan scan;
   scan.angle_min = -M_PI / 2;

@@ -39,7 +39,9 @@ struct PathFollowerOptions {
   double doorway_angular_velocity = 0.15;
   // Recovery: not moving (less than stall_distance and stall_angle) for stall_timeout seconds while it should
   // triggers a recovery: back off for backoff_time at backoff_velocity (when the laser sees room behind), then
-  // turn in place towards the freer side for recovery_rotate_time.
+  // turn in place towards the freer side for recovery_rotate_time. When the last recovery (of any goal) did not
+  // move the robot and it is still where that one started, the turn goes the other way: a robot wedged
+  // diagonally in a passage is freed only by the turn that straightens it.
   double stall_timeout = 3.0;
   double stall_distance = 0.05;
   double stall_angle = 0.15;
@@ -139,6 +141,8 @@ class PathFollower {
   // forward (lane ahead free); on both halves, creeping straight ahead without turning (lane ahead free).
   VelocityCommand turnInPlace(double angular, const std::vector<Point2>& obstacles, double front_clearance) const;
   double remainingLength(const Pose2& pose);
+  // Whether `pose` is within stall_distance and stall_angle of `since` (the robot has not moved).
+  bool withinStall(const Pose2& pose, const Pose2& since) const;
 
   PathFollowerOptions options_;
   std::vector<Point2> path_;
@@ -156,6 +160,8 @@ class PathFollower {
   Pose2 recovery_start_pose_;
   int recoveries_ = 0;
   int recoveries_without_motion_ = 0;
+  // Kept across goals: whether the last recovery moved the robot (else the next one turns the other way).
+  bool last_recovery_moved_ = true;
   // Held from outside since held_since_ (hold()).
   bool held_ = false;
   double held_since_ = 0.0;

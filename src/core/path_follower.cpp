@@ -157,6 +157,11 @@ void PathFollower::hold(double time) {
   held_since_ = time;
 }
 
+bool PathFollower::withinStall(const Pose2& pose, const Pose2& since) const {
+  return std::hypot(pose.x - since.x, pose.y - since.y) <= options_.stall_distance &&
+         std::abs(wrapAngle(pose.yaw - since.yaw)) <= options_.stall_angle;
+}
+
 double PathFollower::remainingLength(const Pose2& pose) {
   // The closest path point, searched from the last one on (the robot does not go back along its path); a
   // window keeps a path that passes near itself from being skipped.
@@ -229,14 +234,12 @@ FollowerStep PathFollower::update(const Pose2& pose, const std::vector<Point2>& 
     }
     state_ = FollowerState::kFollowing;
     anchor_set_ = false;
-    if (std::hypot(pose.x - recovery_start_pose_.x, pose.y - recovery_start_pose_.y) <= options_.stall_distance &&
-        std::abs(wrapAngle(pose.yaw - recovery_start_pose_.yaw)) <= options_.stall_angle)
-      ++recoveries_without_motion_;
+    last_recovery_moved_ = !withinStall(pose, recovery_start_pose_);
+    if (!last_recovery_moved_) ++recoveries_without_motion_;
   }
 
   // Stall watch: no motion for stall_timeout while following starts a recovery (or fails after too many).
-  if (!anchor_set_ || std::hypot(pose.x - anchor_pose_.x, pose.y - anchor_pose_.y) > options_.stall_distance ||
-      std::abs(wrapAngle(pose.yaw - anchor_pose_.yaw)) > options_.stall_angle) {
+  if (!anchor_set_ || !withinStall(pose, anchor_pose_)) {
     anchor_pose_ = pose;
     anchor_time_ = time;
     anchor_set_ = true;
@@ -246,12 +249,16 @@ FollowerStep PathFollower::update(const Pose2& pose, const std::vector<Point2>& 
       return step;
     }
     ++recoveries_;
+    if (!last_recovery_moved_ && withinStall(pose, recovery_start_pose_)) {
+      recovery_turn_sign_ = -recovery_turn_sign_;  // that turn was blocked: the other way
+    } else {
+      // Turn towards the side with more room: the mean lateral position of nearby points tells the crowded side.
+      double lateral = 0.0;
+      for (const Point2& point : obstacles)
+        if (point.allFinite() && point.norm() < 1.5) lateral += point.y();
+      recovery_turn_sign_ = lateral > 0.0 ? -1.0 : 1.0;
+    }
     recovery_start_pose_ = pose;
-    // Turn towards the side with more room: the mean lateral position of nearby points tells the crowded side.
-    double lateral = 0.0;
-    for (const Point2& point : obstacles)
-      if (point.allFinite() && point.norm() < 1.5) lateral += point.y();
-    recovery_turn_sign_ = lateral > 0.0 ? -1.0 : 1.0;
     state_ = FollowerState::kBackingOff;
     recovery_until_ = time + options_.backoff_time;
     anchor_set_ = false;
