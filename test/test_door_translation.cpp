@@ -41,12 +41,7 @@ TEST(PoseLog, RoundTripsAndReadsFrames) {
 
 TEST(PoseLog, RejectsBadLogsNamingTheLine) {
   const auto problem = [](const std::string& text) {
-    try {
-      parsePoseLog(text, "bad.log");
-    } catch (const InputError& error) {
-      return std::string(error.what());
-    }
-    return std::string("no error");
+    return testing::inputErrorMessage([&] { parsePoseLog(text, "bad.log"); });
   };
   EXPECT_NE(problem("# only a comment\n").find("no poses"), std::string::npos);
   EXPECT_NE(problem("0.0 1 2 3\n0.1 1 2\n").find("line 2"), std::string::npos);

@@ -18,6 +18,8 @@
 namespace hidden_rooms {
 namespace {
 
+using testing::inputErrorMessage;
+
 // The map cut to the bounding box of its known cells (what a slice of its extrusion covers).
 OccupancyGrid cropToKnown(const OccupancyGrid& map) {
   const cv::Rect box = cv::boundingRect(map.cells != OccupancyGrid::kUnknown);
@@ -140,29 +142,22 @@ TEST(OctomapIo, RoomsYamlBecomesLabels) {
 
 TEST(OctomapIo, BadInputGivesClearErrors) {
   const std::string dir = testing::makeTempDir("octomap_bad");
-  const auto message = [](const auto& call) {
-    try {
-      call();
-    } catch (const InputError& error) {
-      return std::string(error.what());
-    }
-    return std::string("no error");
-  };
-  EXPECT_NE(message([&] { sliceOctomap(dir + "/missing.bt", SliceOptions()); }).find("no such file"),
+  EXPECT_NE(inputErrorMessage([&] { sliceOctomap(dir + "/missing.bt", SliceOptions()); }).find("no such file"),
             std::string::npos);
   std::ofstream(dir + "/garbage.bt") << "not an octree";
-  EXPECT_NE(message([&] { sliceOctomap(dir + "/garbage.bt", SliceOptions()); }).find("garbage.bt"),
+  EXPECT_NE(inputErrorMessage([&] { sliceOctomap(dir + "/garbage.bt", SliceOptions()); }).find("garbage.bt"),
             std::string::npos);
   std::ofstream(dir + "/garbage.ot") << "# Octomap OcTree file\nid NoSuchTree\n";
-  EXPECT_NE(message([&] { sliceOctomap(dir + "/garbage.ot", SliceOptions()); }).find("garbage.ot"),
+  EXPECT_NE(inputErrorMessage([&] { sliceOctomap(dir + "/garbage.ot", SliceOptions()); }).find("garbage.ot"),
             std::string::npos);
   std::ofstream(dir + "/map.png") << "x";
-  EXPECT_NE(message([&] { sliceOctomap(dir + "/map.png", SliceOptions()); }).find("unknown OctoMap file type"),
+  EXPECT_NE(inputErrorMessage([&] { sliceOctomap(dir + "/map.png", SliceOptions()); }).find("unknown OctoMap file type"),
             std::string::npos);
   SliceOptions inverted;
   inverted.z_min = 2.0;
   inverted.z_max = 1.0;
-  EXPECT_NE(message([&] { sliceOctomap(dir + "/garbage.bt", inverted); }).find("z_min < z_max"), std::string::npos);
+  EXPECT_NE(inputErrorMessage([&] { sliceOctomap(dir + "/garbage.bt", inverted); }).find("z_min < z_max"),
+            std::string::npos);
 
   OccupancyGrid map;
   map.cells = cv::Mat_<int8_t>(10, 10, OccupancyGrid::kFree);
@@ -184,12 +179,7 @@ TEST(OctomapIo, DamagedTreesAreRefusedBeforeOctomapReadsThem) {
   cv::Mat1w truth;
   testing::syntheticHiddenRoomA(&map, &doors, &truth);
   const auto error = [](const std::string& path) {
-    try {
-      sliceOctomap(path, SliceOptions());
-    } catch (const InputError& refused) {
-      return std::string(refused.what());
-    }
-    return std::string("no error");
+    return inputErrorMessage([&] { sliceOctomap(path, SliceOptions()); });
   };
   const auto write = [&](const std::string& name, const std::string& bytes) {
     std::ofstream(dir + "/" + name, std::ios::binary) << bytes;

@@ -11,6 +11,7 @@
 #include <opencv2/core.hpp>
 
 #include "hidden_rooms/doors_file.h"
+#include "hidden_rooms/input_error.h"
 #include "hidden_rooms/occupancy_grid.h"
 
 namespace hidden_rooms::testing {
@@ -46,6 +47,16 @@ inline std::vector<std::string> sharedEnvironmentFiles() {
     if (entry.path().extension() == ".xml") files.push_back(entry.path().string());
   std::sort(files.begin(), files.end());
   return files;
+}
+
+// The message of the InputError that `call` throws; "no error" when it returns (other exceptions pass through).
+inline std::string inputErrorMessage(const std::function<void()>& call) {
+  try {
+    call();
+  } catch (const InputError& error) {
+    return error.what();
+  }
+  return "no error";
 }
 
 // A fresh empty temporary folder for one test.
