@@ -53,8 +53,13 @@ Mapper::Mapper(ros::NodeHandle nh, const MapperOptions& options)
   metadata_publisher_ = nh.advertise<nav_msgs::MapMetaData>("map_metadata", 1, true);
   if (options.publish_particles) particles_publisher_ = nh.advertise<geometry_msgs::PoseArray>("particles", 1);
   save_service_ = nh.advertiseService("save_map", &Mapper::onSaveMap, this);
-  if (options.tf_publish_rate > 0.0)
-    tf_timer_ = nh.createTimer(ros::Duration(1.0 / options.tf_publish_rate), &Mapper::onTimer, this);
+  if (options.tf_publish_rate > 0.0) {
+    ros::NodeHandle tf_nh(nh);
+    tf_nh.setCallbackQueue(&tf_queue_);
+    tf_timer_ = tf_nh.createTimer(ros::Duration(1.0 / options.tf_publish_rate), &Mapper::onTimer, this);
+    tf_spinner_ = std::make_unique<ros::AsyncSpinner>(1, &tf_queue_);
+    tf_spinner_->start();
+  }
 }
 
 // Scans that would harm the filter are ignored on arrival, each kind with its own throttled warning: stamps
@@ -125,6 +130,10 @@ bool Mapper::process(const sensor_msgs::LaserScan& scan) {
     ++dropped_;
     return false;
   }
+  {
+    std::lock_guard<std::mutex> lock(transform_mutex_);
+    map_to_odom_ = mapper_->mapToOdom();
+  }
   // With a tf rate the timer publishes map -> odom (one stamp per ROS time, no repeated data), else each scan.
   if (options_.tf_publish_rate <= 0.0) publishTransform(scan.header.stamp);
   if (options_.publish_particles)
@@ -145,15 +154,15 @@ void Mapper::publishMap(const ros::Time& stamp) {
 }
 
 void Mapper::publishTransform(const ros::Time& stamp) {
+  std::lock_guard<std::mutex> lock(transform_mutex_);
+  if (!map_to_odom_) return;             // no scan processed yet
   if (stamp <= last_tf_stamp_) return;  // time has not moved (simulated clock slower than the timer)
   last_tf_stamp_ = stamp;
-  tf_broadcaster_.sendTransform(toTransform(mapper_->mapToOdom(), options_.map_frame, options_.odom_frame,
+  tf_broadcaster_.sendTransform(toTransform(*map_to_odom_, options_.map_frame, options_.odom_frame,
                                             stamp + ros::Duration(options_.transform_tolerance)));
 }
 
-void Mapper::onTimer(const ros::TimerEvent&) {
-  if (processed_ > 0) publishTransform(ros::Time::now());
-}
+void Mapper::onTimer(const ros::TimerEvent&) { publishTransform(ros::Time::now()); }
 
 bool Mapper::onSaveMap(hidden_rooms::SaveMap::Request& request, hidden_rooms::SaveMap::Response& response) {
   const OccupancyGrid grid = mapper_->map();

@@ -2,10 +2,14 @@
 
 #include <deque>
 #include <memory>
+#include <mutex>
+#include <optional>
 #include <string>
 
 #include <hidden_rooms/SaveMap.h>
+#include <ros/callback_queue.h>
 #include <ros/ros.h>
+#include <ros/spinner.h>
 #include <sensor_msgs/LaserScan.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_broadcaster.h>
@@ -37,7 +41,8 @@ MapperOptions readMapperOptions(const ros::NodeHandle& private_nh);
 
 // SLAM node over the core's RbpfMapper: each scan of `scan_topic` with the odometry (tf odom -> base_link at the
 // scan's stamp) goes to MRPT's RBPF; publishes the map (latched), map_metadata, the particles and tf
-// map -> odom, and serves save_map.
+// map -> odom, and serves save_map. With a tf rate, map -> odom is republished from its own thread, so a long
+// filter update or map rendering (large maps) does not leave the tree without a recent map -> odom.
 class Mapper {
  public:
   // Loads the MRPT options (throws InputError when it cannot); does not wait for anything.
@@ -55,6 +60,7 @@ class Mapper {
   void processPending();
   bool process(const sensor_msgs::LaserScan& scan);
   void publishMap(const ros::Time& stamp);
+  // Publishes the last map -> odom (if any) at `stamp` + transform_tolerance, once per stamp.
   void publishTransform(const ros::Time& stamp);
   void onTimer(const ros::TimerEvent& event);
   bool onSaveMap(hidden_rooms::SaveMap::Request& request, hidden_rooms::SaveMap::Response& response);
@@ -67,7 +73,6 @@ class Mapper {
   std::deque<sensor_msgs::LaserScan::ConstPtr> pending_;
   ros::Time last_map_stamp_;
   ros::Time last_scan_stamp_;
-  ros::Time last_tf_stamp_;
   bool map_published_ = false;
   int processed_ = 0;
   int dropped_ = 0;
@@ -77,7 +82,15 @@ class Mapper {
   ros::Publisher metadata_publisher_;
   ros::Publisher particles_publisher_;
   ros::ServiceServer save_service_;
+  // map -> odom after the last processed scan and the stamp it was last sent with: written by the scan callback,
+  // read by the tf timer's thread.
+  std::mutex transform_mutex_;
+  std::optional<Pose2> map_to_odom_;
+  ros::Time last_tf_stamp_;
+  // The tf timer's own queue and thread (declared last: the thread stops before the timer and queue go).
+  ros::CallbackQueue tf_queue_;
   ros::Timer tf_timer_;
+  std::unique_ptr<ros::AsyncSpinner> tf_spinner_;
 };
 
 }  // namespace hidden_rooms
