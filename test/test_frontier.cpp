@@ -1,10 +1,12 @@
 // Frontier extraction (groups, small ones and unknown specks dropped) and the nearest-frontier goal by path cost.
+#include <algorithm>
 #include <cmath>
 
 #include <gtest/gtest.h>
 
 #include "hidden_rooms/frontier.h"
 #include "hidden_rooms/grid_planner.h"
+#include "hidden_rooms/input_error.h"
 
 namespace hidden_rooms {
 namespace {
@@ -145,6 +147,60 @@ TEST(Frontier, PlacesWhereTheRobotWasStuckAreReleasedForAnotherTry) {
                  both.add(goal->position);
                  return both;
                }(), FrontierOptions()).has_value());
+}
+
+// A straight path along y = 2 from x = 0 to x = 5 in 0.05 m steps.
+std::vector<Point2> straightPath() {
+  std::vector<Point2> path;
+  for (int i = 0; i <= 100; ++i) path.emplace_back(0.05 * i, 2.0);
+  return path;
+}
+
+TEST(BlockedPassages, TwoFailuresFromOnePlaceBlockThePathAheadOfTheRobot) {
+  BlockedPassages passages;  // 2 failures, same place within 0.5 m, stretch 0.25..1.0 m ahead
+  EXPECT_FALSE(passages.addFailure(Point2(2.0, 2.1), straightPath()));
+  EXPECT_TRUE(passages.blockedPoints().empty());
+  EXPECT_FALSE(passages.addFailure(Point2(4.0, 2.0), straightPath()));  // another place
+  EXPECT_TRUE(passages.blockedPoints().empty());
+  EXPECT_TRUE(passages.addFailure(Point2(2.3, 2.0), straightPath()));  // 0.3 m from the first, same way
+  ASSERT_FALSE(passages.blockedPoints().empty());
+  for (const Point2& point : passages.blockedPoints()) {
+    EXPECT_GE(point.x(), 2.0 + 0.25 - 1e-9);  // ahead of the first failure's robot, not where it stood ...
+    EXPECT_LE(point.x(), 2.3 + 1.0 + 1e-9);   // ... up to 1 m ahead of the second's
+  }
+  // The failure at x = 4 is still pending: one more there blocks its stretch too; a release opens all, once.
+  EXPECT_TRUE(passages.addFailure(Point2(4.1, 2.0), straightPath()));
+  EXPECT_GT(passages.releaseOnce(), 0u);
+  EXPECT_TRUE(passages.blockedPoints().empty());
+  EXPECT_FALSE(passages.addFailure(Point2(1.0, 2.0), straightPath()));
+  EXPECT_TRUE(passages.addFailure(Point2(1.0, 2.0), straightPath()));
+  EXPECT_EQ(passages.releaseOnce(), 0u);  // blocked for good now
+  EXPECT_FALSE(passages.blockedPoints().empty());
+
+  // Failures from one place in different directions: the robot is stuck there; what was blocked from there is
+  // opened, and later failures there block nothing.
+  BlockedPassages wedged;
+  std::vector<Point2> back = straightPath();
+  std::reverse(back.begin(), back.end());
+  EXPECT_FALSE(wedged.addFailure(Point2(2.0, 2.0), straightPath()));
+  EXPECT_TRUE(wedged.addFailure(Point2(2.1, 2.0), straightPath()));
+  EXPECT_FALSE(wedged.blockedPoints().empty());
+  EXPECT_TRUE(wedged.addFailure(Point2(2.0, 2.0), back));  // the other way
+  EXPECT_TRUE(wedged.blockedPoints().empty());
+  for (int i = 0; i < 3; ++i) EXPECT_FALSE(wedged.addFailure(Point2(2.0, 2.1), straightPath()));
+  EXPECT_TRUE(wedged.blockedPoints().empty());
+
+  BlockedPassagesOptions never;
+  never.failures = 0;
+  BlockedPassages off(never);
+  for (int i = 0; i < 3; ++i) EXPECT_FALSE(off.addFailure(Point2(2.0, 2.0), straightPath()));
+  EXPECT_TRUE(off.blockedPoints().empty());
+  BlockedPassagesOptions bad;
+  bad.skip = 2.0;  // beyond length
+  EXPECT_THROW(BlockedPassages{bad}, InputError);
+  bad = BlockedPassagesOptions();
+  bad.radius = -0.1;
+  EXPECT_THROW(BlockedPassages{bad}, InputError);
 }
 
 TEST(Frontier, UnreachableFrontierGivesNoGoal) {

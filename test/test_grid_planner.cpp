@@ -203,6 +203,29 @@ TEST(GridPlanner, NarrowBandOnlyWhereThereIsNoRoomyWay) {
   EXPECT_TRUE(narrow);
 }
 
+TEST(GridPlanner, BlockedPointsCloseADoorUntilUnblocked) {
+  GridPlanner planner;
+  planner.setMap(roomWithDoor(1.0));
+  ASSERT_TRUE(planner.computeCostsFrom(Point2(2.0, 3.0)));
+  ASSERT_TRUE(std::isfinite(planner.costTo(Point2(6.0, 3.0))));
+  // Points across the door's middle, blocking 0.15 m around each: the room behind is cut off, at once and in the
+  // next map.
+  planner.setBlockedPoints({Point2(4.05, 2.85), Point2(4.05, 3.05), Point2(4.05, 3.25)}, 0.15);
+  ASSERT_TRUE(planner.computeCostsFrom(Point2(2.0, 3.0)));
+  EXPECT_TRUE(std::isinf(planner.costTo(Point2(6.0, 3.0))));
+  int col = 0, row = 0;
+  ASSERT_TRUE(planner.map().cellOf(Point2(4.05, 3.05), &col, &row));
+  EXPECT_EQ(planner.traversable()(row, col), 0);
+  planner.setMap(roomWithDoor(1.0));
+  ASSERT_TRUE(planner.computeCostsFrom(Point2(2.0, 3.0)));
+  EXPECT_TRUE(std::isinf(planner.costTo(Point2(6.0, 3.0))));
+  // Elsewhere in the room nothing changed.
+  EXPECT_TRUE(std::isfinite(planner.costTo(Point2(2.0, 5.0))));
+  planner.setBlockedPoints({}, 0.0);
+  ASSERT_TRUE(planner.computeCostsFrom(Point2(2.0, 3.0)));
+  EXPECT_TRUE(std::isfinite(planner.costTo(Point2(6.0, 3.0))));
+}
+
 TEST(GridPlanner, EmptyMapPlansNothing) {
   GridPlanner planner;
   planner.setMap(OccupancyGrid());

@@ -52,6 +52,52 @@ struct Blacklist {
   size_t releaseStuck();
 };
 
+// Passages the robot failed to get through. A goal that fails while the robot moves (it made no progress along
+// its path) leaves the stretch of path just ahead of the robot, where the robot could not pass; once `failures`
+// goals have failed from the same place in the same direction, their stretches are blocked for the planner
+// (GridPlanner::setBlockedPoints), so the frontiers behind a gap the robot cannot pass are not tried over and over.
+// Failures from one place in different directions mean the robot itself is stuck there: nothing is blocked from
+// that place (what was is opened again).
+struct BlockedPassagesOptions {
+  int failures = 2;          // goals failed from one place in one direction that block their stretches (0 = never)
+  double same_place = 0.5;   // metres: failures with the robot this close count as one place
+  double same_direction = 0.8;  // radians: stretches whose directions from the robot differ less agree
+  double skip = 0.25;        // metres of the path ahead of the robot left open (the robot stands there) ...
+  double length = 1.0;       // ... up to this many metres ahead are the stretch
+  double radius = 0.15;      // metres around each stretch point that are blocked
+};
+
+// Throws InputError("explorer options", ...) naming a negative, non-finite or inconsistent option.
+void validate(const BlockedPassagesOptions& options);
+
+class BlockedPassages {
+ public:
+  explicit BlockedPassages(const BlockedPassagesOptions& options = BlockedPassagesOptions());
+  // A goal failed with the robot at `robot` following `path` (map frame, from where it started). True when
+  // blockedPoints() changed.
+  bool addFailure(const Point2& robot, const std::vector<Point2>& path);
+  // Points whose disc of options().radius the planner must not cross.
+  const std::vector<Point2>& blockedPoints() const { return blocked_; }
+  // Opens every blocked passage again, once per explorer run (when no other goal is left, in case a passage was
+  // blocked by failures that had another cause); returns how many points were unblocked (0 after the first time).
+  size_t releaseOnce();
+  const BlockedPassagesOptions& options() const { return options_; }
+
+ private:
+  struct Failure {
+    Point2 robot;
+    Point2 direction;  // unit vector from the robot to the stretch's end
+    std::vector<Point2> stretch;
+    bool blocking = false;
+  };
+  void collectBlocked();
+  BlockedPassagesOptions options_;
+  std::vector<Failure> failures_;
+  std::vector<Point2> wedged_;  // places the robot failed from in different directions
+  std::vector<Point2> blocked_;
+  bool released_ = false;
+};
+
 struct FrontierGoal {
   int frontier_label = 0;  // label in the FrontierMap
   cv::Point cell;          // the goal cell (traversable, reachable)

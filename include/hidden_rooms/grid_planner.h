@@ -39,6 +39,9 @@ class GridPlanner {
 
   // Builds the inflated cost map; an empty map gives a planner where nothing is reachable.
   void setMap(const OccupancyGrid& map);
+  // Cells within `radius` (metres) of these points (map frame) are neither traversable nor roomy, in this map and
+  // the next ones, until set again (an empty list unblocks). Applies at once; the next computeCostsFrom uses it.
+  void setBlockedPoints(const std::vector<Point2>& points, double radius);
   const OccupancyGrid& map() const { return map_; }
 
   // Costs from `start` (map frame) to every traversable cell. False (and nothing reachable) when the start lies
@@ -73,6 +76,8 @@ class GridPlanner {
   cv::Mat1d cost_;         // path cost from the start (infinity where unreachable)
   cv::Mat1i parent_;       // index (row * width + col) of the predecessor, -1 at the start / unreached
   cv::Point start_cell_{-1, -1};
+  std::vector<Point2> blocked_points_;
+  double blocked_radius_ = 0.0;
 };
 
 // Length (metres) of a polyline.

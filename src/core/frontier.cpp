@@ -2,8 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 #include <opencv2/imgproc.hpp>
+
+#include "hidden_rooms/input_error.h"
 
 namespace hidden_rooms {
 
@@ -77,6 +80,69 @@ size_t Blacklist::releaseStuck() {
     points.erase(std::remove_if(points.begin(), points.end(), [&](const Point2& listed) { return listed == stuck; }),
                  points.end());
   stuck_points.clear();
+  return released;
+}
+
+void validate(const BlockedPassagesOptions& options) {
+  const auto require = [](bool ok, const std::string& what) {
+    if (!ok) throw InputError("explorer options", what);
+  };
+  require(options.failures >= 0, "blocked_passage_failures must be >= 0");
+  for (const double value : {options.same_place, options.same_direction, options.skip, options.length, options.radius})
+    require(std::isfinite(value) && value >= 0.0, "blocked passage distances and angles must be >= 0");
+  require(options.skip < options.length, "need blocked_passage_skip < blocked_passage_length");
+}
+
+BlockedPassages::BlockedPassages(const BlockedPassagesOptions& options) : options_(options) { validate(options_); }
+
+bool BlockedPassages::addFailure(const Point2& robot, const std::vector<Point2>& path) {
+  if (options_.failures <= 0 || path.empty()) return false;
+  const auto here = [&](const Point2& place) { return (place - robot).norm() <= options_.same_place; };
+  if (std::any_of(wedged_.begin(), wedged_.end(), here)) return false;
+  // The stretch: path points between skip and length metres along the path from the point nearest the robot.
+  size_t nearest = 0;
+  for (size_t i = 1; i < path.size(); ++i)
+    if ((path[i] - robot).norm() < (path[nearest] - robot).norm()) nearest = i;
+  Failure failure{robot, Point2::Zero(), {}, false};
+  double along = 0.0;
+  for (size_t i = nearest + 1; i < path.size() && along <= options_.length; ++i) {
+    along += (path[i] - path[i - 1]).norm();
+    if (along >= options_.skip && along <= options_.length) failure.stretch.push_back(path[i]);
+  }
+  if (failure.stretch.empty() || (failure.stretch.back() - robot).norm() < 1e-9) return false;
+  failure.direction = (failure.stretch.back() - robot).normalized();
+
+  const size_t blocked_before = blocked_.size();
+  const auto from_here = [&](const Failure& other) { return here(other.robot); };
+  const double agreement = std::cos(options_.same_direction);
+  const bool wedged = std::any_of(failures_.begin(), failures_.end(), [&](const Failure& other) {
+    return from_here(other) && other.direction.dot(failure.direction) < agreement;
+  });
+  if (wedged) {
+    wedged_.push_back(robot);
+    failures_.erase(std::remove_if(failures_.begin(), failures_.end(), from_here), failures_.end());
+  } else {
+    failures_.push_back(failure);
+    if (std::count_if(failures_.begin(), failures_.end(), from_here) >= options_.failures)
+      for (Failure& other : failures_)
+        if (from_here(other)) other.blocking = true;
+  }
+  collectBlocked();
+  return blocked_.size() != blocked_before;
+}
+
+void BlockedPassages::collectBlocked() {
+  blocked_.clear();
+  for (const Failure& failure : failures_)
+    if (failure.blocking) blocked_.insert(blocked_.end(), failure.stretch.begin(), failure.stretch.end());
+}
+
+size_t BlockedPassages::releaseOnce() {
+  if (released_ || blocked_.empty()) return 0;
+  released_ = true;
+  const size_t released = blocked_.size();
+  failures_.clear();
+  blocked_.clear();
   return released;
 }
 

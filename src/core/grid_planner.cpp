@@ -80,6 +80,20 @@ void GridPlanner::setMap(const OccupancyGrid& map) {
       const double narrow = distance < options_.robot_radius ? options_.narrow_cost_factor : 1.0;
       step_factor_(row, col) = static_cast<float>(narrow * (1.0 + options_.cost_weight * closeness));
     }
+  const int blocked_cells = static_cast<int>(std::lround(blocked_radius_ / map.resolution));
+  for (const Point2& point : blocked_points_) {
+    int col = 0, row = 0;
+    if (!map.cellOf(point, &col, &row)) continue;
+    cv::circle(traversable_, {col, row}, blocked_cells, 0, cv::FILLED);
+    cv::circle(roomy_, {col, row}, blocked_cells, 0, cv::FILLED);
+  }
+}
+
+void GridPlanner::setBlockedPoints(const std::vector<Point2>& points, double radius) {
+  blocked_points_ = points;
+  blocked_radius_ = radius;
+  const OccupancyGrid map = map_;
+  setMap(map);
 }
 
 bool GridPlanner::computeCostsFrom(const Point2& start) {

@@ -88,6 +88,12 @@ ExplorerOptions readExplorerOptions(const ros::NodeHandle& nh) {
   nh.param("max_recoveries", follower.max_recoveries, follower.max_recoveries);
   validate(follower);
 
+  BlockedPassagesOptions& passages = options.passages;
+  nh.param("blocked_passage_failures", passages.failures, passages.failures);
+  nh.param("blocked_passage_length", passages.length, passages.length);
+  nh.param("blocked_passage_radius", passages.radius, passages.radius);
+  validate(passages);
+
   nh.param("map_frame", options.map_frame, options.map_frame);
   nh.param("base_frame", options.base_frame, options.base_frame);
   nh.param("control_rate", options.control_rate, options.control_rate);
@@ -122,6 +128,7 @@ Explorer::Explorer(ros::NodeHandle nh, const ExplorerOptions& options)
     : options_(options),
       planner_(options.planner),
       follower_(options.follower),
+      passages_(options.passages),
       tf_buffer_(ros::Duration(10.0)),
       tf_listener_(tf_buffer_),
       obstacle_memory_(options.obstacle_memory) {
@@ -261,6 +268,17 @@ void Explorer::onTimer(const ros::TimerEvent&) {
     else if (step.state == FollowerState::kFailed)
       ROS_WARN("explorer: goal (%.2f, %.2f) not reached (%d recoveries, no progress); blacklisted",
                goal_->position.x(), goal_->position.y(), follower_.recoveries());
+    const size_t blocked_before = passages_.blockedPoints().size();
+    if (step.state == FollowerState::kFailed && !robot_stuck &&
+        passages_.addFailure(Point2(pose.x, pose.y), follower_.path())) {
+      planner_.setBlockedPoints(passages_.blockedPoints(), options_.passages.radius);
+      if (passages_.blockedPoints().size() > blocked_before)
+        ROS_WARN("explorer: %d goals failed from (%.2f, %.2f) in one direction: the path ahead is blocked for the "
+                 "planner", options_.passages.failures, pose.x, pose.y);
+      else
+        ROS_WARN("explorer: goals failed from (%.2f, %.2f) in different directions: the robot is stuck there, not "
+                 "a passage ahead; opened again", pose.x, pose.y);
+    }
     goal_.reset();
     plan(pose, now);
     if (goal_) {
@@ -305,6 +323,17 @@ void Explorer::plan(const Pose2& pose, const ros::Time& now) {
     ROS_WARN("explorer: no other goal; %zu goals failed while the robot could not move: trying them again",
              blacklist_.releaseStuck());
     goal = nearestFrontierGoal(frontiers, planner_, blacklist_, options_.frontiers, previous, options_.goal_hysteresis);
+  }
+  if (!goal) {
+    const size_t unblocked = passages_.releaseOnce();
+    if (unblocked > 0) {
+      // A passage may have been blocked by failures with another cause: before done, each is tried once more.
+      ROS_WARN("explorer: no other goal; opening the blocked passages again (%zu points, once)", unblocked);
+      planner_.setBlockedPoints({}, 0.0);
+      if (planner_.computeCostsFrom(Point2(pose.x, pose.y)))
+        goal = nearestFrontierGoal(frontiers, planner_, blacklist_, options_.frontiers, previous,
+                                   options_.goal_hysteresis);
+    }
   }
   if (!goal) {
     goal_.reset();
@@ -410,6 +439,18 @@ void Explorer::publishMarkers(const FrontierMap& frontiers, const ros::Time& now
     blacklisted.color = colour(1.0f, 0.0f, 0.0f, 0.8f);
     for (const Point2& point : blacklist_.points) blacklisted.points.push_back(toPoint(point, 0.1));
     markers.markers.push_back(blacklisted);
+  }
+  if (!passages_.blockedPoints().empty()) {
+    visualization_msgs::Marker blocked = cells;
+    blocked.ns = "blocked_passages";
+    blocked.type = visualization_msgs::Marker::SPHERE_LIST;
+    blocked.points.clear();
+    blocked.colors.clear();
+    blocked.scale.x = blocked.scale.y = 2.0 * options_.passages.radius;
+    blocked.scale.z = 0.05;
+    blocked.color = colour(0.6f, 0.0f, 0.6f, 0.6f);
+    for (const Point2& point : passages_.blockedPoints()) blocked.points.push_back(toPoint(point));
+    markers.markers.push_back(blocked);
   }
   markers_publisher_.publish(markers);
 }

@@ -21,6 +21,7 @@ struct ExplorerOptions {
   GridPlannerOptions planner;    // inflation, proximity cost, smoothing
   FrontierOptions frontiers;     // frontier filtering, goal reach
   PathFollowerOptions follower;  // pure pursuit, laser speed limit, recovery
+  BlockedPassagesOptions passages;  // gaps the robot failed to pass, blocked for the planner
   std::string map_frame = "map";
   std::string base_frame = "base_link";
   double control_rate = 10.0;       // Hz of ROS time: commands (and replanning when due)
@@ -39,8 +40,8 @@ struct ExplorerOptions {
 ExplorerOptions readExplorerOptions(const ros::NodeHandle& private_nh);
 
 // Nearest-frontier exploration (replaces explore + move_base): frontiers of the latest `map`, the one nearest by
-// path cost as goal, a wavefront path to it, pure pursuit with a laser speed limit on `base_scan`, recovery and a
-// blacklist. Publishes `cmd_vel`, `exploration_markers` and the latched `exploration_done`. Stops (and holds the
+// path cost as goal, a wavefront path to it, pure pursuit with a laser speed limit on `base_scan`, recovery, a
+// blacklist and blocked passages. Publishes `cmd_vel`, `exploration_markers` and the latched `exploration_done`. Stops (and holds the
 // follower) while the map, the pose or the scan is stale; does not report done while goals failed only because
 // the robot could not move.
 class Explorer {
@@ -67,6 +68,7 @@ class Explorer {
   GridPlanner planner_;
   PathFollower follower_;
   Blacklist blacklist_;
+  BlockedPassages passages_;
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;
   nav_msgs::OccupancyGrid::ConstPtr latest_map_;
