@@ -104,6 +104,20 @@ TEST(DefaultPredictor, RecoversRoomsOfARotatedMap) {
   for (size_t k = 0; k < scores.iou.size(); ++k) EXPECT_GT(scores.iou[k], 0.7) << "door " << k + 1;
 }
 
+TEST(DefaultPredictor, MeasuresDepthBehindARaggedWall) {
+  // A SLAM map's wall, turned back by the dominant angle, is ragged: away from the door its pixels reach a row
+  // or two past the door's first unknown row (here row 96 at door 1, in 3 of 4 columns). The depth is measured
+  // behind them, not stopped on them.
+  Synthetic s = syntheticFloor(0.0);
+  for (int col = 40; col < 140; ++col)
+    if ((col < 78 || col > 102) && col % 4 != 0) s.request.map.cells(96, col) = OccupancyGrid::kOccupied;
+  s.truth.setTo(0, s.request.map.cells != OccupancyGrid::kUnknown);
+  s.request.parameters = {{"default_grown_area_ratio", 1e9}};  // the rectangles only
+  const PredictionResult result = makeRoomPredictor("default")->predict(s.request);
+  EXPECT_NEAR(result.rooms[0].terms.at("depth"), 76 * 0.05, 0.1);
+  EXPECT_GT(scoreOf(s, result).iou[0], 0.8);
+}
+
 TEST(DefaultPredictor, IsDeterministic) {
   const Synthetic s = syntheticFloor(7.0);
   const auto predictor = makeRoomPredictor("default");

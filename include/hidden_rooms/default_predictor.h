@@ -18,7 +18,8 @@
 //      default_wall_gap, e.g. open doorways) and the space just behind it is still unknown (a known pixel
 //      there is a perpendicular wall of an explored room);
 //    - doors on the same wall and the same side split their shared extent at the midpoint between them;
-//    - depth: per column of the extent, the unknown run behind the wall up to the first known pixel; the
+//    - depth: per column of the extent, the unknown run behind the wall (past the column's own wall pixels
+//      within 0.15 m: a ragged or slightly tilted SLAM wall) up to the first known pixel; the
 //      median when enough columns end on a known pixel inside the known map's bounding box, else a prior: the
 //      depth of the explored rooms on the same side of the same wall, else of the other hidden rooms on that
 //      side, else the room's width (a square, as the thesis does).

@@ -33,6 +33,7 @@ constexpr double kWallMargin = -1.0;         // m: unseen wall thickness left ou
 // Working states of a pixel; map values at or above kOccupiedFrom are walls.
 constexpr uint8_t kUnknownPx = 0, kFreePx = 1, kOccupiedPx = 2;
 constexpr int8_t kOccupiedFrom = 50;
+constexpr double kWallDrift = 0.15;  // m: how far past the door's first unknown row a tilted wall may reach
 
 cv::Mat1b statesOf(const OccupancyGrid& map) {
   cv::Mat1b states(map.cells.size(), kUnknownPx);
@@ -261,9 +262,14 @@ void measureDepth(const Frame& f, double resolution, const Parameters& P, DoorFr
   const int margin = width / 10;
   d->bounded_depths.clear();
   int columns = 0;
+  // A slightly tilted wall (SLAM maps) reaches a few rows past s0 away from the door: a column's run starts
+  // after its own wall pixels within that drift.
+  const int drift = std::max(1, static_cast<int>(std::lround(kWallDrift / resolution)));
   for (int u = d->left + margin; u <= d->right - margin; ++u) {
     ++columns;
-    for (int v = d->s0; v <= d->s0 + max_v; ++v) {
+    int v = d->s0;
+    while (v < d->s0 + drift && f.inside(f.at(*d, u, v)) && f.state(f.at(*d, u, v)) != kUnknownPx) ++v;
+    for (; v <= d->s0 + max_v; ++v) {
       const cv::Point q = f.at(*d, u, v);
       if (!f.inside(q) || !f.inBox(q)) break;
       if (f.state(q) != kUnknownPx) {

@@ -90,7 +90,7 @@ void validate(const BlockedPassagesOptions& options) {
   require(options.failures >= 0, "blocked_passage_failures must be >= 0");
   for (const double value : {options.same_place, options.same_direction, options.skip, options.length, options.radius})
     require(std::isfinite(value) && value >= 0.0, "blocked passage distances and angles must be >= 0");
-  require(options.skip < options.length, "need blocked_passage_skip < blocked_passage_length");
+  require(options.skip < options.length, "the blocked stretch must start (skip) before it ends (length)");
 }
 
 BlockedPassages::BlockedPassages(const BlockedPassagesOptions& options) : options_(options) { validate(options_); }

@@ -429,29 +429,24 @@ void Explorer::publishMarkers(const FrontierMap& frontiers, const ros::Time& now
     if (path.points.size() >= 2) markers.markers.push_back(path);
   }
 
-  if (!blacklist_.points.empty()) {
-    visualization_msgs::Marker blacklisted = cells;
-    blacklisted.ns = "blacklist";
-    blacklisted.type = visualization_msgs::Marker::SPHERE_LIST;
-    blacklisted.points.clear();
-    blacklisted.colors.clear();
-    blacklisted.scale.x = blacklisted.scale.y = blacklisted.scale.z = 0.2;
-    blacklisted.color = colour(1.0f, 0.0f, 0.0f, 0.8f);
-    for (const Point2& point : blacklist_.points) blacklisted.points.push_back(toPoint(point, 0.1));
-    markers.markers.push_back(blacklisted);
-  }
-  if (!passages_.blockedPoints().empty()) {
-    visualization_msgs::Marker blocked = cells;
-    blocked.ns = "blocked_passages";
-    blocked.type = visualization_msgs::Marker::SPHERE_LIST;
-    blocked.points.clear();
-    blocked.colors.clear();
-    blocked.scale.x = blocked.scale.y = 2.0 * options_.passages.radius;
-    blocked.scale.z = 0.05;
-    blocked.color = colour(0.6f, 0.0f, 0.6f, 0.6f);
-    for (const Point2& point : passages_.blockedPoints()) blocked.points.push_back(toPoint(point));
-    markers.markers.push_back(blocked);
-  }
+  // Places as spheres of `diameter` metres (flattened to `height`) at `z`.
+  const auto spheres = [&](const char* ns, const std::vector<Point2>& places, double diameter, double height,
+                           double z, const std_msgs::ColorRGBA& tint) {
+    if (places.empty()) return;
+    visualization_msgs::Marker marker = cells;
+    marker.ns = ns;
+    marker.type = visualization_msgs::Marker::SPHERE_LIST;
+    marker.points.clear();
+    marker.colors.clear();
+    marker.scale.x = marker.scale.y = diameter;
+    marker.scale.z = height;
+    marker.color = tint;
+    for (const Point2& place : places) marker.points.push_back(toPoint(place, z));
+    markers.markers.push_back(marker);
+  };
+  spheres("blacklist", blacklist_.points, 0.2, 0.2, 0.1, colour(1.0f, 0.0f, 0.0f, 0.8f));
+  spheres("blocked_passages", passages_.blockedPoints(), 2.0 * options_.passages.radius, 0.05, 0.05,
+          colour(0.6f, 0.0f, 0.6f, 0.6f));
   markers_publisher_.publish(markers);
 }
 
