@@ -151,7 +151,8 @@ TEST(OctomapIo, BadInputGivesClearErrors) {
   EXPECT_NE(inputErrorMessage([&] { sliceOctomap(dir + "/garbage.ot", SliceOptions()); }).find("garbage.ot"),
             std::string::npos);
   std::ofstream(dir + "/map.png") << "x";
-  EXPECT_NE(inputErrorMessage([&] { sliceOctomap(dir + "/map.png", SliceOptions()); }).find("unknown OctoMap file type"),
+  EXPECT_NE(inputErrorMessage([&] { sliceOctomap(dir + "/map.png", SliceOptions()); })
+                .find("unknown OctoMap file type"),
             std::string::npos);
   SliceOptions inverted;
   inverted.z_min = 2.0;

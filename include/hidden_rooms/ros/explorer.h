@@ -41,9 +41,9 @@ ExplorerOptions readExplorerOptions(const ros::NodeHandle& private_nh);
 
 // Nearest-frontier exploration (replaces explore + move_base): frontiers of the latest `map`, the one nearest by
 // path cost as goal, a wavefront path to it, pure pursuit with a laser speed limit on `base_scan`, recovery, a
-// blacklist and blocked passages. Publishes `cmd_vel`, `exploration_markers` and the latched `exploration_done`. Stops (and holds the
-// follower) while the map, the pose or the scan is stale; does not report done while goals failed only because
-// the robot could not move.
+// blacklist and blocked passages. Publishes `cmd_vel`, `exploration_markers` and the latched `exploration_done`.
+// Stops (and holds the follower) while the map, the pose or the scan is stale; does not report done while goals
+// failed only because the robot could not move.
 class Explorer {
  public:
   // Subscribes and advertises; does not wait for anything (the control timer does the work).
