@@ -124,29 +124,62 @@ TEST(Frontier, NearestGoalIsTheCheaperEndAndSkipsTheBlacklist) {
   EXPECT_LT(nearestFrontierGoal(frontiers, planner, Blacklist(), options, other->position, 100.0)->position.x(), 1.0);
 }
 
-TEST(Frontier, PlacesWhereTheRobotWasStuckAreReleasedForAnotherTry) {
-  const OccupancyGrid grid = corridorWithTwoEnds();
-  GridPlanner planner;
-  planner.setMap(grid);
-  ASSERT_TRUE(planner.computeCostsFrom(Point2(7.0, 2.0)));
-  const FrontierMap frontiers = findFrontiers(grid);
-  Blacklist blacklist;
-  blacklist.radius = 3.0;
-  blacklist.add(Point2(9.8, 2.0), /*robot_stuck=*/true);  // failed while the robot could not move
-  blacklist.add(Point2(0.2, 2.0));                         // failed while it moved
-  EXPECT_FALSE(nearestFrontierGoal(frontiers, planner, blacklist, FrontierOptions()).has_value());
-  EXPECT_EQ(blacklist.releaseStuck(), 1u);
-  EXPECT_EQ(blacklist.points.size(), 1u);
-  EXPECT_TRUE(blacklist.stuck_points.empty());
-  const std::optional<FrontierGoal> goal = nearestFrontierGoal(frontiers, planner, blacklist, FrontierOptions());
-  ASSERT_TRUE(goal.has_value());
-  EXPECT_GT(goal->position.x(), 9.0);
-  EXPECT_EQ(blacklist.releaseStuck(), 0u);
-  EXPECT_FALSE(nearestFrontierGoal(frontiers, planner, [&] {
-                 Blacklist both = blacklist;
-                 both.add(goal->position);
-                 return both;
-               }(), FrontierOptions()).has_value());
+// The corridor with two frontier ends, searched from (7, 2), and a blacklist whose radius covers either end.
+class BlacklistRelease : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    planner_.setMap(grid_);
+    ASSERT_TRUE(planner_.computeCostsFrom(Point2(7.0, 2.0)));
+    blacklist_.radius = 3.0;
+  }
+  std::optional<FrontierGoal> goal() const {
+    return nearestFrontierGoal(frontiers_, planner_, blacklist_, FrontierOptions());
+  }
+  const OccupancyGrid grid_ = corridorWithTwoEnds();
+  const FrontierMap frontiers_ = findFrontiers(grid_);
+  GridPlanner planner_;
+  Blacklist blacklist_;
+};
+
+TEST_F(BlacklistRelease, PlacesWhereTheRobotWasStuckAreTriedAgain) {
+  blacklist_.add(Point2(9.8, 2.0), GoalOutcome::kRobotStuck);  // failed while the robot could not move
+  blacklist_.add(Point2(0.2, 2.0), GoalOutcome::kReached);     // reached, its frontier still there
+  EXPECT_FALSE(goal().has_value());
+  EXPECT_EQ(blacklist_.releaseFailed(), 0u);
+  EXPECT_EQ(blacklist_.releaseStuck(), 1u);
+  EXPECT_EQ(blacklist_.points.size(), 1u);
+  EXPECT_TRUE(blacklist_.stuck_points.empty());
+  const std::optional<FrontierGoal> again = goal();
+  ASSERT_TRUE(again.has_value());
+  EXPECT_GT(again->position.x(), 9.0);
+  EXPECT_EQ(blacklist_.releaseStuck(), 0u);
+  // Stuck there again: released again next time (the recoveries are what may free the robot).
+  blacklist_.add(again->position, GoalOutcome::kRobotStuck);
+  EXPECT_FALSE(goal().has_value());
+  EXPECT_EQ(blacklist_.releaseStuck(), 1u);
+}
+
+TEST_F(BlacklistRelease, FailedPlacesGetOneSecondTry) {
+  blacklist_.add(Point2(0.2, 2.0), GoalOutcome::kReached);
+  blacklist_.add(Point2(9.8, 2.0), GoalOutcome::kFailed);
+  EXPECT_FALSE(goal().has_value());
+  EXPECT_EQ(blacklist_.releaseStuck(), 0u);
+  // The failed place is released, the reached one is not.
+  EXPECT_EQ(blacklist_.releaseFailed(), 1u);
+  ASSERT_EQ(blacklist_.points.size(), 1u);
+  EXPECT_EQ(blacklist_.points[0], Point2(0.2, 2.0));
+  const std::optional<FrontierGoal> again = goal();
+  ASSERT_TRUE(again.has_value());
+  EXPECT_GT(again->position.x(), 9.0);
+  // It fails again (near the retried place): blacklisted for good.
+  blacklist_.add(again->position, GoalOutcome::kFailed);
+  EXPECT_TRUE(blacklist_.failed_points.empty());
+  EXPECT_EQ(blacklist_.releaseFailed(), 0u);
+  EXPECT_FALSE(goal().has_value());
+  // A failure elsewhere gets its own second try.
+  blacklist_.add(Point2(5.0, 9.0), GoalOutcome::kFailed);
+  EXPECT_EQ(blacklist_.releaseFailed(), 1u);
+  EXPECT_EQ(blacklist_.points.size(), 2u);
 }
 
 // A straight path along y = 2 from x = 0 to x = 5 in 0.05 m steps.

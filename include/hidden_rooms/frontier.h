@@ -38,18 +38,33 @@ struct FrontierMap {
 // groups under min_frontier_cells dropped. An empty map has none.
 FrontierMap findFrontiers(const OccupancyGrid& map, const FrontierOptions& options = FrontierOptions());
 
+// How a goal ended, for the blacklist.
+enum class GoalOutcome {
+  kReached,     // reached, but its frontier is still there: it cannot be seen from there
+  kFailed,      // not reached although the robot moved (no progress, or out of recoveries)
+  kRobotStuck,  // not reached because the robot could not move at all (its recoveries produced no motion)
+};
+
 // Places the robot should not be sent to again (map frame): a candidate goal within `radius` of any is skipped.
+// Failed places get one more try when nothing else is left: a failure can have a passing cause (a mapping glitch,
+// a late control loop), and a blacklisted doorway hides everything behind it.
 struct Blacklist {
   std::vector<Point2> points;
   double radius = 0.8;  // metres
-  // Of `points`, the goals that failed while the robot could not move at all (its recoveries produced no
-  // motion): the robot was stuck, the place may be fine.
+  // Of `points`, the goals that failed while the robot could not move at all: the robot was stuck, the place may
+  // be fine.
   std::vector<Point2> stuck_points;
+  // Of `points`, the goals that failed while the robot moved and are not within `radius` of a place that already
+  // had its second try.
+  std::vector<Point2> failed_points;
+  // Places released by releaseFailed(); failures near them stay blacklisted.
+  std::vector<Point2> retried_points;
   bool contains(const Point2& point) const;
-  // Adds a failed or reached goal; `robot_stuck` also lists it in stuck_points.
-  void add(const Point2& point, bool robot_stuck = false);
+  void add(const Point2& point, GoalOutcome outcome);
   // Takes the stuck places off the list, so that they are tried again; returns how many there were.
   size_t releaseStuck();
+  // Takes failed_points off the list for their second try (they become retried_points); returns how many.
+  size_t releaseFailed();
 };
 
 // Passages the robot failed to get through. A goal that fails while the robot moves (it made no progress along

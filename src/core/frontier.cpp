@@ -69,18 +69,32 @@ bool Blacklist::contains(const Point2& point) const {
                      [&](const Point2& listed) { return (listed - point).norm() <= radius; });
 }
 
-void Blacklist::add(const Point2& point, bool robot_stuck) {
+void Blacklist::add(const Point2& point, GoalOutcome outcome) {
   points.push_back(point);
-  if (robot_stuck) stuck_points.push_back(point);
+  if (outcome == GoalOutcome::kRobotStuck) stuck_points.push_back(point);
+  const auto near = [&](const Point2& place) { return (place - point).norm() <= radius; };
+  if (outcome == GoalOutcome::kFailed && std::none_of(retried_points.begin(), retried_points.end(), near))
+    failed_points.push_back(point);
 }
 
-size_t Blacklist::releaseStuck() {
-  const size_t released = stuck_points.size();
-  for (const Point2& stuck : stuck_points)
-    points.erase(std::remove_if(points.begin(), points.end(), [&](const Point2& listed) { return listed == stuck; }),
-                 points.end());
-  stuck_points.clear();
-  return released;
+namespace {
+
+// Removes every occurrence of each of `released` from `points`; returns how many `released` there were.
+size_t removePoints(std::vector<Point2>* released, std::vector<Point2>* points) {
+  for (const Point2& place : *released)
+    points->erase(std::remove(points->begin(), points->end(), place), points->end());
+  const size_t count = released->size();
+  released->clear();
+  return count;
+}
+
+}  // namespace
+
+size_t Blacklist::releaseStuck() { return removePoints(&stuck_points, &points); }
+
+size_t Blacklist::releaseFailed() {
+  retried_points.insert(retried_points.end(), failed_points.begin(), failed_points.end());
+  return removePoints(&failed_points, &points);
 }
 
 void validate(const BlockedPassagesOptions& options) {

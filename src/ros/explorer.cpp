@@ -255,18 +255,21 @@ void Explorer::onTimer(const ros::TimerEvent&) {
       publishCommand(step.command);
       return;
     }
-    // A reached goal whose frontier is still there next time cannot be seen from there; a failed one cannot be
-    // reached: either way no goal near it again. A goal failed because the robot could not move at all (no
-    // recovery moved it) is tried again when nothing else is left.
+    // A reached goal whose frontier is still there next time cannot be seen from there: no goal near it again.
+    // A failed one gets one more try when nothing else is left; one failed because the robot could not move at
+    // all (no recovery moved it), a try each time nothing else is left.
     const bool robot_stuck = step.state == FollowerState::kFailed && follower_.recoveries() > 0 &&
                              follower_.recoveriesWithoutMotion() == follower_.recoveries();
-    blacklist_.add(goal_->position, robot_stuck);
+    blacklist_.add(goal_->position, step.state == FollowerState::kGoalReached ? GoalOutcome::kReached
+                                    : robot_stuck                            ? GoalOutcome::kRobotStuck
+                                                                             : GoalOutcome::kFailed);
     if (robot_stuck)
       ROS_WARN("explorer: goal (%.2f, %.2f) failed: the robot did not move in %d recoveries (stuck?); "
                "blacklisted until no other goal is left", goal_->position.x(), goal_->position.y(),
                follower_.recoveries());
     else if (step.state == FollowerState::kFailed)
-      ROS_WARN("explorer: goal (%.2f, %.2f) not reached (%d recoveries, no progress); blacklisted",
+      ROS_WARN("explorer: goal (%.2f, %.2f) not reached (%d recoveries, no progress); blacklisted (a second try "
+               "when no other goal is left)",
                goal_->position.x(), goal_->position.y(), follower_.recoveries());
     const size_t blocked_before = passages_.blockedPoints().size();
     if (step.state == FollowerState::kFailed && !robot_stuck &&
@@ -334,6 +337,10 @@ void Explorer::plan(const Pose2& pose, const ros::Time& now) {
         goal = nearestFrontierGoal(frontiers, planner_, blacklist_, options_.frontiers, previous,
                                    options_.goal_hysteresis);
     }
+  }
+  if (!goal && !blacklist_.failed_points.empty()) {
+    ROS_WARN("explorer: no other goal; %zu failed goals get their second try", blacklist_.releaseFailed());
+    goal = nearestFrontierGoal(frontiers, planner_, blacklist_, options_.frontiers, previous, options_.goal_hysteresis);
   }
   if (!goal) {
     goal_.reset();
