@@ -142,8 +142,8 @@ class BlacklistRelease : public ::testing::Test {
 };
 
 TEST_F(BlacklistRelease, PlacesWhereTheRobotWasStuckAreTriedAgain) {
-  blacklist_.add(Point2(9.8, 2.0), GoalOutcome::kRobotStuck);  // failed while the robot could not move
-  blacklist_.add(Point2(0.2, 2.0), GoalOutcome::kReached);     // reached, its frontier still there
+  EXPECT_TRUE(blacklist_.add(Point2(9.8, 2.0), GoalOutcome::kRobotStuck));  // failed, the robot could not move
+  EXPECT_FALSE(blacklist_.add(Point2(0.2, 2.0), GoalOutcome::kReached));    // reached, its frontier still there
   EXPECT_FALSE(goal().has_value());
   EXPECT_EQ(blacklist_.releaseFailed(), 0u);
   EXPECT_EQ(blacklist_.releaseStuck(), 1u);
@@ -160,8 +160,8 @@ TEST_F(BlacklistRelease, PlacesWhereTheRobotWasStuckAreTriedAgain) {
 }
 
 TEST_F(BlacklistRelease, FailedPlacesGetOneSecondTry) {
-  blacklist_.add(Point2(0.2, 2.0), GoalOutcome::kReached);
-  blacklist_.add(Point2(9.8, 2.0), GoalOutcome::kFailed);
+  EXPECT_FALSE(blacklist_.add(Point2(0.2, 2.0), GoalOutcome::kReached));
+  EXPECT_TRUE(blacklist_.add(Point2(9.8, 2.0), GoalOutcome::kFailed));
   EXPECT_FALSE(goal().has_value());
   EXPECT_EQ(blacklist_.releaseStuck(), 0u);
   // The failed place is released, the reached one is not.
@@ -172,12 +172,12 @@ TEST_F(BlacklistRelease, FailedPlacesGetOneSecondTry) {
   ASSERT_TRUE(again.has_value());
   EXPECT_GT(again->position.x(), 9.0);
   // It fails again (near the retried place): blacklisted for good.
-  blacklist_.add(again->position, GoalOutcome::kFailed);
+  EXPECT_FALSE(blacklist_.add(again->position, GoalOutcome::kFailed));
   EXPECT_TRUE(blacklist_.failed_points.empty());
   EXPECT_EQ(blacklist_.releaseFailed(), 0u);
   EXPECT_FALSE(goal().has_value());
   // A failure elsewhere gets its own second try.
-  blacklist_.add(Point2(5.0, 9.0), GoalOutcome::kFailed);
+  EXPECT_TRUE(blacklist_.add(Point2(5.0, 9.0), GoalOutcome::kFailed));
   EXPECT_EQ(blacklist_.releaseFailed(), 1u);
   EXPECT_EQ(blacklist_.points.size(), 2u);
 }

@@ -60,7 +60,8 @@ struct Blacklist {
   // Places released by releaseFailed(); failures near them stay blacklisted.
   std::vector<Point2> retried_points;
   bool contains(const Point2& point) const;
-  void add(const Point2& point, GoalOutcome outcome);
+  // Lists the place; true when it is kept for a later release (robot stuck, or a first failure there).
+  bool add(const Point2& point, GoalOutcome outcome);
   // Takes the stuck places off the list, so that they are tried again; returns how many there were.
   size_t releaseStuck();
   // Takes failed_points off the list for their second try (they become retried_points); returns how many.

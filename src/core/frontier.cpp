@@ -69,12 +69,16 @@ bool Blacklist::contains(const Point2& point) const {
                      [&](const Point2& listed) { return (listed - point).norm() <= radius; });
 }
 
-void Blacklist::add(const Point2& point, GoalOutcome outcome) {
+bool Blacklist::add(const Point2& point, GoalOutcome outcome) {
   points.push_back(point);
-  if (outcome == GoalOutcome::kRobotStuck) stuck_points.push_back(point);
+  if (outcome == GoalOutcome::kRobotStuck) {
+    stuck_points.push_back(point);
+    return true;
+  }
   const auto near = [&](const Point2& place) { return (place - point).norm() <= radius; };
-  if (outcome == GoalOutcome::kFailed && std::none_of(retried_points.begin(), retried_points.end(), near))
-    failed_points.push_back(point);
+  if (outcome != GoalOutcome::kFailed || std::any_of(retried_points.begin(), retried_points.end(), near)) return false;
+  failed_points.push_back(point);
+  return true;
 }
 
 namespace {

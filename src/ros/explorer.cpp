@@ -260,17 +260,18 @@ void Explorer::onTimer(const ros::TimerEvent&) {
     // all (no recovery moved it), a try each time nothing else is left.
     const bool robot_stuck = step.state == FollowerState::kFailed && follower_.recoveries() > 0 &&
                              follower_.recoveriesWithoutMotion() == follower_.recoveries();
-    blacklist_.add(goal_->position, step.state == FollowerState::kGoalReached ? GoalOutcome::kReached
-                                    : robot_stuck                            ? GoalOutcome::kRobotStuck
-                                                                             : GoalOutcome::kFailed);
+    const bool released_later =
+        blacklist_.add(goal_->position, step.state == FollowerState::kGoalReached ? GoalOutcome::kReached
+                                        : robot_stuck                            ? GoalOutcome::kRobotStuck
+                                                                                 : GoalOutcome::kFailed);
     if (robot_stuck)
       ROS_WARN("explorer: goal (%.2f, %.2f) failed: the robot did not move in %d recoveries (stuck?); "
                "blacklisted until no other goal is left", goal_->position.x(), goal_->position.y(),
                follower_.recoveries());
     else if (step.state == FollowerState::kFailed)
-      ROS_WARN("explorer: goal (%.2f, %.2f) not reached (%d recoveries, no progress); blacklisted (a second try "
-               "when no other goal is left)",
-               goal_->position.x(), goal_->position.y(), follower_.recoveries());
+      ROS_WARN("explorer: goal (%.2f, %.2f) not reached (%d recoveries, no progress); blacklisted (%s)",
+               goal_->position.x(), goal_->position.y(), follower_.recoveries(),
+               released_later ? "a second try when no other goal is left" : "it failed there on its second try");
     const size_t blocked_before = passages_.blockedPoints().size();
     if (step.state == FollowerState::kFailed && !robot_stuck &&
         passages_.addFailure(Point2(pose.x, pose.y), follower_.path())) {
