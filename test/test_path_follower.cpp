@@ -354,6 +354,29 @@ TEST(PathFollower, ObstaclePointsSkipInvalidReturnsAndApplyTheLaserPose) {
   EXPECT_NEAR(points[1].y(), -2.0, 1e-9);
 }
 
+TEST(PathFollower, WallsBesideTheFootprintLeaveItsLaneOpen) {
+  PathFollowerOptions options;
+  const double half_length = 0.5 * options.footprint_length, half_width = 0.5 * options.footprint_width;
+  // Walls 0.03 m beside both sides (within side_margin) along the whole footprint: the robot may drive on and back
+  // off straight.
+  std::vector<Point2> tunnel;
+  for (double x = -half_length; x <= half_length + 1e-9; x += 0.02) {
+    tunnel.emplace_back(x, half_width + 0.03);
+    tunnel.emplace_back(x, -half_width - 0.03);
+  }
+  EXPECT_EQ(frontClearance(tunnel, options), std::numeric_limits<double>::infinity());
+  EXPECT_EQ(rearClearance(tunnel, options), std::numeric_limits<double>::infinity());
+  // The walls go on ahead within the side margin (the margin is kept ahead): the lane ends 0.4 m ahead of the
+  // front; behind it stays open.
+  tunnel.emplace_back(half_length + 0.4, half_width + 0.03);
+  EXPECT_NEAR(frontClearance(tunnel, options), 0.4, 1e-9);
+  EXPECT_EQ(rearClearance(tunnel, options), std::numeric_limits<double>::infinity());
+  // A point inside the footprint's rear half (a wall it touches): no room behind, ahead unchanged.
+  tunnel.emplace_back(-0.2, half_width - 0.01);
+  EXPECT_EQ(rearClearance(tunnel, options), 0.0);
+  EXPECT_NEAR(frontClearance(tunnel, options), 0.4, 1e-9);
+}
+
 TEST(PathFollower, ObstacleMemoryKeepsRecentPointsInTheRobotFrame) {
   ObstacleMemory memory(1.0);
   memory.add({Point2(1.0, 0.0)}, Pose2{0.0, 0.0, 0.0}, 0.0);        // a point at map (1, 0)

@@ -93,8 +93,8 @@ class ObstacleMemory {
 };
 
 // Free space (metres) ahead of the robot's front edge within its lane (footprint width plus side_margin on both
-// sides), from obstacle points in base_link; +infinity when the lane is empty. Points beside the robot's front
-// half count as 0.
+// sides), from obstacle points in base_link; +infinity when the lane is empty. Points inside the footprint's front
+// half count as 0; points beside it (in the side margins) do not count: driving straight does not come closer.
 double frontClearance(const std::vector<Point2>& obstacles, const PathFollowerOptions& options);
 // The same behind the rear edge (the laser may not see there: then +infinity).
 double rearClearance(const std::vector<Point2>& obstacles, const PathFollowerOptions& options);

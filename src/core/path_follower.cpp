@@ -103,15 +103,21 @@ std::vector<Point2> ObstacleMemory::points(const Pose2& pose) const {
 
 namespace {
 
-// Free distance beyond the footprint's front (`direction` +1) or rear (-1) within its lane.
+// Free distance beyond the footprint's front (`direction` +1) or rear (-1) within its lane. Points beside the
+// footprint in the lane's side margins do not count (driving straight does not bring them closer); points inside
+// the footprint's half on that side give 0.
 double laneClearance(const std::vector<Point2>& obstacles, const PathFollowerOptions& options, double direction) {
-  const double half_length = 0.5 * options.footprint_length;
-  const double half_lane = 0.5 * options.footprint_width + options.side_margin;
+  const double half_length = 0.5 * options.footprint_length, half_width = 0.5 * options.footprint_width;
+  const double half_lane = half_width + options.side_margin;
   double clearance = kInfinity;
   for (const Point2& point : obstacles) {
     const double along = direction * point.x();
-    if (point.allFinite() && std::abs(point.y()) <= half_lane && (along > 0.0 || (along == 0.0 && direction > 0)))
-      clearance = std::min(clearance, std::max(0.0, along - half_length));
+    if (!point.allFinite() || std::abs(point.y()) > half_lane || along < 0.0 || (along == 0.0 && direction < 0))
+      continue;
+    if (along > half_length)
+      clearance = std::min(clearance, along - half_length);
+    else if (std::abs(point.y()) <= half_width)
+      clearance = 0.0;
   }
   return clearance;
 }
