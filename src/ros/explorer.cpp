@@ -319,14 +319,17 @@ void Explorer::plan(const Pose2& pose, const ros::Time& now) {
   }
   const std::optional<Point2> previous =
       goal_ && follower_.state() == FollowerState::kFollowing ? std::optional<Point2>(goal_->position) : std::nullopt;
-  std::optional<FrontierGoal> goal =
-      nearestFrontierGoal(frontiers, planner_, blacklist_, options_.frontiers, previous, options_.goal_hysteresis);
+  // The nearest goal with the current blacklist and costs (tried again after each release below).
+  const auto nearest = [&] {
+    return nearestFrontierGoal(frontiers, planner_, blacklist_, options_.frontiers, previous, options_.goal_hysteresis);
+  };
+  std::optional<FrontierGoal> goal = nearest();
   if (!goal && !blacklist_.stuck_points.empty()) {
     // Not done while the only goals left failed because the robot could not move: try them again (their
     // recoveries are what may free the robot).
     ROS_WARN("explorer: no other goal; %zu goals failed while the robot could not move: trying them again",
              blacklist_.releaseStuck());
-    goal = nearestFrontierGoal(frontiers, planner_, blacklist_, options_.frontiers, previous, options_.goal_hysteresis);
+    goal = nearest();
   }
   if (!goal) {
     const size_t unblocked = passages_.releaseOnce();
@@ -335,13 +338,12 @@ void Explorer::plan(const Pose2& pose, const ros::Time& now) {
       ROS_WARN("explorer: no other goal; opening the blocked passages again (%zu points, once)", unblocked);
       planner_.setBlockedPoints({}, 0.0);
       if (planner_.computeCostsFrom(Point2(pose.x, pose.y)))
-        goal = nearestFrontierGoal(frontiers, planner_, blacklist_, options_.frontiers, previous,
-                                   options_.goal_hysteresis);
+        goal = nearest();
     }
   }
   if (!goal && !blacklist_.failed_points.empty()) {
     ROS_WARN("explorer: no other goal; %zu failed goals get their second try", blacklist_.releaseFailed());
-    goal = nearestFrontierGoal(frontiers, planner_, blacklist_, options_.frontiers, previous, options_.goal_hysteresis);
+    goal = nearest();
   }
   if (!goal) {
     goal_.reset();
