@@ -25,15 +25,17 @@ cd "$WS"
 rm -rf build/test_results
 catkin_make run_tests -j"$JOBS"
 
-# Sanitizer build of the core and its unit tests, in its own build and devel folders.
+# Sanitizer build of the core and its unit tests (test_core_*), in its own build and devel folders.
 catkin_make --build build_sanitize -DCATKIN_DEVEL_PREFIX="$WS/devel_sanitize" -DHIDDEN_ROOMS_SANITIZE=ON \
   -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPYTHON_EXECUTABLE=/usr/bin/python3 -DPython3_EXECUTABLE=/usr/bin/python3 \
-  -j"$JOBS" test_core
+  -j"$JOBS" hidden_rooms_core_tests
 mkdir -p build/test_results/hidden_rooms
 sanitized_status=0
-ASAN_OPTIONS=detect_leaks=1:abort_on_error=0 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-  "$WS/devel_sanitize/lib/hidden_rooms/test_core" \
-  --gtest_output=xml:"$WS/build/test_results/hidden_rooms/gtest-test_core_sanitized.xml" || sanitized_status=$?
+for test_binary in "$WS"/devel_sanitize/lib/hidden_rooms/test_core_*; do
+  ASAN_OPTIONS=detect_leaks=1:abort_on_error=0 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 "$test_binary" \
+    --gtest_output=xml:"$WS/build/test_results/hidden_rooms/gtest-$(basename "$test_binary")_sanitized.xml" ||
+    sanitized_status=$?
+done
 
 # Every fuzz target briefly (scripts/fuzz.sh runs them as long as asked).
 fuzz_status=0

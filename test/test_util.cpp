@@ -7,11 +7,11 @@
 
 #include <opencv2/imgcodecs.hpp>
 
-#include "hidden_rooms/environment.h"
-#include "hidden_rooms/evaluation.h"
-#include "hidden_rooms/prediction_support.h"
-#include "hidden_rooms/render.h"
-#include "hidden_rooms/room_predictor.h"
+#include "hidden_rooms/evaluation/evaluation.h"
+#include "hidden_rooms/prediction/prediction_support.h"
+#include "hidden_rooms/prediction/room_predictor.h"
+#include "hidden_rooms/world/environment.h"
+#include "hidden_rooms/world/render.h"
 
 #include <fcntl.h>
 #include <signal.h>

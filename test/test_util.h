@@ -10,9 +10,9 @@
 #include <gtest/gtest.h>
 #include <opencv2/core.hpp>
 
-#include "hidden_rooms/doors_file.h"
-#include "hidden_rooms/input_error.h"
-#include "hidden_rooms/occupancy_grid.h"
+#include "hidden_rooms/common/doors_file.h"
+#include "hidden_rooms/common/input_error.h"
+#include "hidden_rooms/common/occupancy_grid.h"
 
 namespace hidden_rooms::testing {
 

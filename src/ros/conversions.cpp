@@ -8,8 +8,9 @@
 
 #include <opencv2/imgproc.hpp>
 
-#include "hidden_rooms/input_error.h"
-#include "hidden_rooms/prediction_support.h"
+#include "hidden_rooms/common/input_error.h"
+#include "hidden_rooms/common/label_image.h"
+#include "hidden_rooms/prediction/prediction_support.h"
 
 namespace hidden_rooms {
 namespace {

@@ -6,8 +6,8 @@
 #include <std_msgs/Bool.h>
 #include <visualization_msgs/MarkerArray.h>
 
-#include "hidden_rooms/input_error.h"
-#include "hidden_rooms/range_scan.h"
+#include "hidden_rooms/common/input_error.h"
+#include "hidden_rooms/common/range_scan.h"
 #include "hidden_rooms/ros/conversions.h"
 
 namespace hidden_rooms {

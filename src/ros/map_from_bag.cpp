@@ -18,16 +18,16 @@
 #include <tf2/exceptions.h>
 #include <tf2_msgs/TFMessage.h>
 
-#include "hidden_rooms/command_line.h"
-#include "hidden_rooms/environment.h"
-#include "hidden_rooms/file_io.h"
-#include "hidden_rooms/image_io.h"
-#include "hidden_rooms/input_error.h"
-#include "hidden_rooms/map_quality.h"
-#include "hidden_rooms/rbpf_mapper.h"
-#include "hidden_rooms/render.h"
+#include "hidden_rooms/common/command_line.h"
+#include "hidden_rooms/common/file_io.h"
+#include "hidden_rooms/common/image_io.h"
+#include "hidden_rooms/common/input_error.h"
+#include "hidden_rooms/evaluation/map_quality.h"
+#include "hidden_rooms/mapping/rbpf_mapper.h"
 #include "hidden_rooms/ros/conversions.h"
 #include "hidden_rooms/ros/mrpt_scan.h"
+#include "hidden_rooms/world/environment.h"
+#include "hidden_rooms/world/render.h"
 
 namespace po = boost::program_options;
 using hidden_rooms::InputError;

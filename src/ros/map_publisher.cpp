@@ -2,9 +2,9 @@
 
 #include <nav_msgs/MapMetaData.h>
 
-#include "hidden_rooms/environment.h"
-#include "hidden_rooms/input_error.h"
+#include "hidden_rooms/common/input_error.h"
 #include "hidden_rooms/ros/conversions.h"
+#include "hidden_rooms/world/environment.h"
 
 namespace hidden_rooms {
 

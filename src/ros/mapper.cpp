@@ -6,8 +6,8 @@
 #include <nav_msgs/MapMetaData.h>
 #include <nav_msgs/OccupancyGrid.h>
 
-#include "hidden_rooms/input_error.h"
-#include "hidden_rooms/occupancy_grid.h"
+#include "hidden_rooms/common/input_error.h"
+#include "hidden_rooms/common/occupancy_grid.h"
 #include "hidden_rooms/ros/conversions.h"
 #include "hidden_rooms/ros/mrpt_scan.h"
 

@@ -1,6 +1,6 @@
 #include <ros/ros.h>
 
-#include "hidden_rooms/input_error.h"
+#include "hidden_rooms/common/input_error.h"
 #include "hidden_rooms/ros/mapper.h"
 
 int main(int argc, char** argv) {

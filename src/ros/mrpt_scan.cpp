@@ -7,7 +7,7 @@
 #include <mrpt/poses/CPose3D.h>
 #include <mrpt/ros1bridge/laser_scan.h>
 
-#include "hidden_rooms/input_error.h"
+#include "hidden_rooms/common/input_error.h"
 
 namespace hidden_rooms {
 

@@ -6,8 +6,8 @@
 
 #include <tf2/exceptions.h>
 
-#include "hidden_rooms/input_error.h"
-#include "hidden_rooms/pose_log.h"
+#include "hidden_rooms/common/input_error.h"
+#include "hidden_rooms/common/pose_log.h"
 #include "hidden_rooms/ros/conversions.h"
 
 namespace hidden_rooms {

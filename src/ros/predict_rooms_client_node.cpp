@@ -7,10 +7,10 @@
 #include <hidden_rooms/PredictRooms.h>
 #include <ros/ros.h>
 
-#include "hidden_rooms/command_line.h"
-#include "hidden_rooms/input_error.h"
-#include "hidden_rooms/prediction_output.h"
-#include "hidden_rooms/room_predictor.h"
+#include "hidden_rooms/common/command_line.h"
+#include "hidden_rooms/common/input_error.h"
+#include "hidden_rooms/evaluation/prediction_output.h"
+#include "hidden_rooms/prediction/room_predictor.h"
 #include "hidden_rooms/ros/conversions.h"
 
 namespace po = boost::program_options;

@@ -11,12 +11,12 @@
 #include <rosbag/bag.h>
 #include <tf2_msgs/TFMessage.h>
 
-#include "hidden_rooms/command_line.h"
-#include "hidden_rooms/environment.h"
-#include "hidden_rooms/input_error.h"
+#include "hidden_rooms/common/command_line.h"
+#include "hidden_rooms/common/input_error.h"
 #include "hidden_rooms/ros/conversions.h"
-#include "hidden_rooms/simulation.h"
-#include "hidden_rooms/wander_driver.h"
+#include "hidden_rooms/simulation/simulation.h"
+#include "hidden_rooms/simulation/wander_driver.h"
+#include "hidden_rooms/world/environment.h"
 
 namespace po = boost::program_options;
 using hidden_rooms::InputError;

@@ -6,10 +6,10 @@
 #include <boost/make_shared.hpp>
 #include <visualization_msgs/MarkerArray.h>
 
-#include "hidden_rooms/input_error.h"
-#include "hidden_rooms/layout.h"
-#include "hidden_rooms/octomap_io.h"
-#include "hidden_rooms/prediction_support.h"
+#include "hidden_rooms/common/input_error.h"
+#include "hidden_rooms/map3d/octomap_io.h"
+#include "hidden_rooms/prediction/layout.h"
+#include "hidden_rooms/prediction/prediction_support.h"
 #include "hidden_rooms/ros/conversions.h"
 
 namespace hidden_rooms {

@@ -7,11 +7,11 @@
 #include <nav_msgs/Odometry.h>
 #include <sensor_msgs/LaserScan.h>
 
-#include "hidden_rooms/environment.h"
-#include "hidden_rooms/image_io.h"
-#include "hidden_rooms/input_error.h"
-#include "hidden_rooms/occupancy_grid.h"
+#include "hidden_rooms/common/image_io.h"
+#include "hidden_rooms/common/input_error.h"
+#include "hidden_rooms/common/occupancy_grid.h"
 #include "hidden_rooms/ros/conversions.h"
+#include "hidden_rooms/world/environment.h"
 
 namespace hidden_rooms {
 

@@ -10,11 +10,13 @@
 #include <optional>
 #include <sstream>
 
-#include "hidden_rooms/batch_case.h"
-#include "hidden_rooms/command_line.h"
-#include "hidden_rooms/doors_file.h"
-#include "hidden_rooms/input_error.h"
-#include "hidden_rooms/occupancy_grid.h"
+#include "hidden_rooms/common/command_line.h"
+#include "hidden_rooms/common/doors_file.h"
+#include "hidden_rooms/common/file_io.h"
+#include "hidden_rooms/common/input_error.h"
+#include "hidden_rooms/common/label_image.h"
+#include "hidden_rooms/common/occupancy_grid.h"
+#include "hidden_rooms/evaluation/batch_case.h"
 
 namespace po = boost::program_options;
 using namespace hidden_rooms;

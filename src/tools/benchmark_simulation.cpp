@@ -8,12 +8,12 @@
 #include <string>
 #include <vector>
 
-#include "hidden_rooms/command_line.h"
-#include "hidden_rooms/environment.h"
-#include "hidden_rooms/input_error.h"
-#include "hidden_rooms/occupancy_grid.h"
-#include "hidden_rooms/simulation.h"
-#include "hidden_rooms/wander_driver.h"
+#include "hidden_rooms/common/command_line.h"
+#include "hidden_rooms/common/input_error.h"
+#include "hidden_rooms/common/occupancy_grid.h"
+#include "hidden_rooms/simulation/simulation.h"
+#include "hidden_rooms/simulation/wander_driver.h"
+#include "hidden_rooms/world/environment.h"
 
 namespace po = boost::program_options;
 using namespace hidden_rooms;

@@ -5,10 +5,10 @@
 #include <limits>
 #include <string>
 
-#include "hidden_rooms/command_line.h"
-#include "hidden_rooms/environment.h"
-#include "hidden_rooms/input_error.h"
-#include "hidden_rooms/world_generator.h"
+#include "hidden_rooms/common/command_line.h"
+#include "hidden_rooms/common/input_error.h"
+#include "hidden_rooms/world/environment.h"
+#include "hidden_rooms/world/world_generator.h"
 
 namespace po = boost::program_options;
 

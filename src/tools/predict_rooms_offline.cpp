@@ -4,9 +4,10 @@
 // are given.
 #include <iostream>
 
-#include "hidden_rooms/command_line.h"
-#include "hidden_rooms/prediction_output.h"
-#include "hidden_rooms/room_predictor.h"
+#include "hidden_rooms/common/command_line.h"
+#include "hidden_rooms/common/file_io.h"
+#include "hidden_rooms/evaluation/prediction_output.h"
+#include "hidden_rooms/prediction/room_predictor.h"
 
 namespace po = boost::program_options;
 using namespace hidden_rooms;

@@ -6,11 +6,13 @@
 #include <set>
 
 
-#include "hidden_rooms/command_line.h"
-#include "hidden_rooms/environment.h"
-#include "hidden_rooms/image_io.h"
-#include "hidden_rooms/input_error.h"
-#include "hidden_rooms/render.h"
+#include "hidden_rooms/common/command_line.h"
+#include "hidden_rooms/common/file_io.h"
+#include "hidden_rooms/common/image_io.h"
+#include "hidden_rooms/common/input_error.h"
+#include "hidden_rooms/common/label_image.h"
+#include "hidden_rooms/world/environment.h"
+#include "hidden_rooms/world/render.h"
 
 namespace po = boost::program_options;
 using namespace hidden_rooms;

@@ -2,8 +2,8 @@
 // into a 2D map, so prediction runs on 3D maps.
 #include <iostream>
 
-#include "hidden_rooms/command_line.h"
-#include "hidden_rooms/octomap_io.h"
+#include "hidden_rooms/common/command_line.h"
+#include "hidden_rooms/map3d/octomap_io.h"
 
 namespace po = boost::program_options;
 using namespace hidden_rooms;

@@ -11,12 +11,13 @@
 
 #include <opencv2/imgproc.hpp>
 
-#include "hidden_rooms/command_line.h"
-#include "hidden_rooms/door_translation.h"
-#include "hidden_rooms/file_io.h"
-#include "hidden_rooms/input_error.h"
-#include "hidden_rooms/map_quality.h"
-#include "hidden_rooms/range_scan.h"
+#include "hidden_rooms/common/command_line.h"
+#include "hidden_rooms/common/file_io.h"
+#include "hidden_rooms/common/input_error.h"
+#include "hidden_rooms/common/label_image.h"
+#include "hidden_rooms/common/range_scan.h"
+#include "hidden_rooms/evaluation/door_translation.h"
+#include "hidden_rooms/evaluation/map_quality.h"
 
 namespace po = boost::program_options;
 using namespace hidden_rooms;

@@ -5,14 +5,14 @@
 #include <filesystem>
 #include <fstream>
 
-#include "hidden_rooms/doors_file.h"
-#include "hidden_rooms/environment.h"
-#include "hidden_rooms/image_io.h"
-#include "hidden_rooms/input_error.h"
-#include "hidden_rooms/occupancy_grid.h"
-#include "hidden_rooms/octomap_io.h"
-#include "hidden_rooms/pose_log.h"
-#include "hidden_rooms/room_predictor.h"
+#include "hidden_rooms/common/doors_file.h"
+#include "hidden_rooms/common/image_io.h"
+#include "hidden_rooms/common/input_error.h"
+#include "hidden_rooms/common/occupancy_grid.h"
+#include "hidden_rooms/common/pose_log.h"
+#include "hidden_rooms/map3d/octomap_io.h"
+#include "hidden_rooms/prediction/room_predictor.h"
+#include "hidden_rooms/world/environment.h"
 
 namespace hidden_rooms::fuzz {
 

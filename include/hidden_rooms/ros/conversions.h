@@ -18,13 +18,13 @@
 #include <sensor_msgs/LaserScan.h>
 #include <visualization_msgs/MarkerArray.h>
 
-#include "hidden_rooms/doors_file.h"
-#include "hidden_rooms/layout.h"
-#include "hidden_rooms/occupancy_grid.h"
-#include "hidden_rooms/range_scan.h"
-#include "hidden_rooms/rbpf_mapper.h"
-#include "hidden_rooms/room_predictor.h"
-#include "hidden_rooms/simulation.h"
+#include "hidden_rooms/common/doors_file.h"
+#include "hidden_rooms/common/occupancy_grid.h"
+#include "hidden_rooms/common/range_scan.h"
+#include "hidden_rooms/mapping/rbpf_mapper.h"
+#include "hidden_rooms/prediction/layout.h"
+#include "hidden_rooms/prediction/room_predictor.h"
+#include "hidden_rooms/simulation/simulation.h"
 
 namespace hidden_rooms {
 

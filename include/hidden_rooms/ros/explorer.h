@@ -10,9 +10,9 @@
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
 
-#include "hidden_rooms/frontier.h"
-#include "hidden_rooms/grid_planner.h"
-#include "hidden_rooms/path_follower.h"
+#include "hidden_rooms/exploration/frontier.h"
+#include "hidden_rooms/exploration/grid_planner.h"
+#include "hidden_rooms/exploration/path_follower.h"
 
 namespace hidden_rooms {
 

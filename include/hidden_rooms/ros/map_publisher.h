@@ -6,7 +6,7 @@
 #include <nav_msgs/OccupancyGrid.h>
 #include <ros/ros.h>
 
-#include "hidden_rooms/render.h"
+#include "hidden_rooms/world/render.h"
 
 namespace hidden_rooms {
 

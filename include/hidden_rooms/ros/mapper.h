@@ -15,7 +15,7 @@
 #include <tf2_ros/transform_broadcaster.h>
 #include <tf2_ros/transform_listener.h>
 
-#include "hidden_rooms/rbpf_mapper.h"
+#include "hidden_rooms/mapping/rbpf_mapper.h"
 
 namespace hidden_rooms {
 

@@ -6,7 +6,7 @@
 #include <mrpt/obs/CObservation2DRangeScan.h>
 #include <sensor_msgs/LaserScan.h>
 
-#include "hidden_rooms/laser_caster.h"
+#include "hidden_rooms/simulation/laser_caster.h"
 
 namespace hidden_rooms {
 

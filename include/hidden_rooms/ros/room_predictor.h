@@ -9,9 +9,9 @@
 #include <nav_msgs/OccupancyGrid.h>
 #include <ros/ros.h>
 
-#include "hidden_rooms/doors_file.h"
-#include "hidden_rooms/occupancy_grid.h"
-#include "hidden_rooms/room_predictor.h"
+#include "hidden_rooms/common/doors_file.h"
+#include "hidden_rooms/common/occupancy_grid.h"
+#include "hidden_rooms/prediction/room_predictor.h"
 
 namespace hidden_rooms {
 

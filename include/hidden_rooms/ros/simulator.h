@@ -12,8 +12,8 @@
 #include <tf2_ros/static_transform_broadcaster.h>
 #include <tf2_ros/transform_broadcaster.h>
 
-#include "hidden_rooms/render.h"
-#include "hidden_rooms/simulation.h"
+#include "hidden_rooms/simulation/simulation.h"
+#include "hidden_rooms/world/render.h"
 
 namespace hidden_rooms {
 

@@ -1,0 +1,18 @@
+#pragma once
+
+// Label images: per cell 0 (no label) or a label k >= 1 (a room, a space).
+
+#include <string>
+
+#include <opencv2/core.hpp>
+
+namespace hidden_rooms {
+
+// Writes a label image as PNG: 8-bit when every label fits, else 16-bit. Throws InputError on failure.
+void saveLabelImage(const cv::Mat1w& labels, const std::string& path);
+
+// The colour of the room with label k (1-based) in every picture and rviz overlay, BGR: hues spread by the
+// golden angle, so that neighbouring labels differ.
+cv::Vec3b roomColour(int label);
+
+}  // namespace hidden_rooms

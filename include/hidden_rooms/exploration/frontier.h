@@ -1,0 +1,135 @@
+#pragma once
+
+#include <limits>
+#include <optional>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "hidden_rooms/common/geometry.h"
+#include "hidden_rooms/common/occupancy_grid.h"
+#include "hidden_rooms/exploration/grid_planner.h"
+
+namespace hidden_rooms {
+
+struct FrontierOptions {
+  int free_threshold = 19;       // cells with 0 <= value <= this are free ...
+  int occupied_threshold = 65;   // ... with value >= this occupied; the rest (and -1) count as unknown
+  int min_frontier_cells = 8;    // frontiers (8-connected groups) with fewer cells are dropped
+  int min_unknown_cells = 20;    // unknown areas (4-connected) with fewer cells are specks, not frontier material
+  double goal_reach = 0.6;       // metres: a goal is a traversable cell within this distance of the frontier ...
+  double min_goal_distance = 0.5;  // ... and at least this far from the robot (a goal at the robot teaches nothing)
+};
+
+// A frontier: a connected group of free cells that border unknown space.
+struct Frontier {
+  int label = 0;                 // 1-based, its value in FrontierMap::labels
+  std::vector<cv::Point> cells;  // (col, row) in the map's image order
+  Point2 centroid = Point2::Zero();  // map frame, metres
+};
+
+struct FrontierMap {
+  std::vector<Frontier> frontiers;  // sorted by size, largest first (labels 1..n in that order)
+  cv::Mat1i labels;                 // per cell: label of its frontier, 0 elsewhere (map's size)
+};
+
+// Frontier cells are free cells with a 4-neighbour that is unknown (-1, or neither free nor occupied, or outside
+// the grid) and belongs to an unknown area of at least min_unknown_cells; they are grouped 8-connected (OpenCV connected components) and
+// groups under min_frontier_cells dropped. An empty map has none.
+FrontierMap findFrontiers(const OccupancyGrid& map, const FrontierOptions& options = FrontierOptions());
+
+// How a goal ended, for the blacklist.
+enum class GoalOutcome {
+  kReached,     // reached, but its frontier is still there: it cannot be seen from there
+  kFailed,      // not reached although the robot moved (no progress, or out of recoveries)
+  kRobotStuck,  // not reached because the robot could not move at all (its recoveries produced no motion)
+};
+
+// Places the robot should not be sent to again (map frame): a candidate goal within `radius` of any is skipped.
+// Failed places get one more try when nothing else is left: a failure can have a passing cause (a mapping glitch,
+// a late control loop), and a blacklisted doorway hides everything behind it.
+struct Blacklist {
+  std::vector<Point2> points;
+  double radius = 0.8;  // metres
+  // Of `points`, the goals that failed while the robot could not move at all: the robot was stuck, the place may
+  // be fine.
+  std::vector<Point2> stuck_points;
+  // Of `points`, the goals that failed while the robot moved and are not within `radius` of a place that already
+  // had its second try.
+  std::vector<Point2> failed_points;
+  // Places released by releaseFailed(); failures near them stay blacklisted.
+  std::vector<Point2> retried_points;
+  bool contains(const Point2& point) const;
+  // Lists the place; true when it is kept for a later release (robot stuck, or a first failure there).
+  bool add(const Point2& point, GoalOutcome outcome);
+  // Takes the stuck places off the list, so that they are tried again; returns how many there were.
+  size_t releaseStuck();
+  // Takes failed_points off the list for their second try (they become retried_points); returns how many.
+  size_t releaseFailed();
+};
+
+// Passages the robot failed to get through. A goal that fails while the robot moves (it made no progress along
+// its path) leaves the stretch of path just ahead of the robot, where the robot could not pass; once `failures`
+// goals have failed from the same place in the same direction, their stretches are blocked for the planner
+// (GridPlanner::setBlockedPoints), so the frontiers behind a gap the robot cannot pass are not tried over and over.
+// Failures from one place in different directions mean the robot itself is stuck there: nothing is blocked from
+// that place (what was is opened again).
+struct BlockedPassagesOptions {
+  int failures = 2;          // goals failed from one place in one direction that block their stretches (0 = never)
+  double same_place = 0.5;   // metres: failures with the robot this close count as one place
+  double same_direction = 0.8;  // radians: stretches whose directions from the robot differ less agree
+  double skip = 0.25;        // metres of the path ahead of the robot left open (the robot stands there) ...
+  double length = 1.0;       // ... up to this many metres ahead are the stretch
+  double radius = 0.15;      // metres around each stretch point that are blocked
+};
+
+// Throws InputError("explorer options", ...) naming a negative, non-finite or inconsistent option.
+void validate(const BlockedPassagesOptions& options);
+
+class BlockedPassages {
+ public:
+  explicit BlockedPassages(const BlockedPassagesOptions& options = BlockedPassagesOptions());
+  // A goal failed with the robot at `robot` following `path` (map frame, from where it started). True when
+  // blockedPoints() changed.
+  bool addFailure(const Point2& robot, const std::vector<Point2>& path);
+  // Points whose disc of options().radius the planner must not cross.
+  const std::vector<Point2>& blockedPoints() const { return blocked_; }
+  // Opens every blocked passage again, once per explorer run (when no other goal is left, in case a passage was
+  // blocked by failures that had another cause); returns how many points were unblocked (0 after the first time).
+  size_t releaseOnce();
+  const BlockedPassagesOptions& options() const { return options_; }
+
+ private:
+  struct Failure {
+    Point2 robot;
+    Point2 direction;  // unit vector from the robot to the stretch's end
+    std::vector<Point2> stretch;
+    bool blocking = false;
+  };
+  void collectBlocked();
+  BlockedPassagesOptions options_;
+  std::vector<Failure> failures_;
+  std::vector<Point2> wedged_;  // places the robot failed from in different directions
+  std::vector<Point2> blocked_;
+  bool released_ = false;
+};
+
+struct FrontierGoal {
+  int frontier_label = 0;  // label in the FrontierMap
+  cv::Point cell;          // the goal cell (traversable, reachable)
+  Point2 position = Point2::Zero();  // its centre, map frame
+  double cost = std::numeric_limits<double>::infinity();  // the planner's path cost to it
+};
+
+// The frontier nearest by path cost: over every roomy cell (planner.roomy(): at least robot_radius from obstacles)
+// reachable in `planner`'s last search that lies within options.goal_reach of a frontier cell, at least options.min_goal_distance from the search's start cell
+// and not in `blacklist`, the cheapest. With `previous` (the goal
+// being driven to; min_goal_distance does not apply to it), that goal is kept while some frontier is still within goal_reach of it and it costs at most
+// `hysteresis` metres more than the best (so replanning on every map does not make the robot dither). Nothing
+// when no frontier is reachable.
+std::optional<FrontierGoal> nearestFrontierGoal(const FrontierMap& frontiers, const GridPlanner& planner,
+                                                const Blacklist& blacklist, const FrontierOptions& options,
+                                                const std::optional<Point2>& previous = std::nullopt,
+                                                double hysteresis = 1.0);
+
+}  // namespace hidden_rooms

@@ -1,0 +1,80 @@
+#pragma once
+
+// The project's own prediction method, "default": per closed door, a rectangle fitted to the walls the robot saw
+// around the door, or the room grown on the layout's cell grid by the thesis's method (thesis_predictor.h, with
+// its default parameters) when that room is at least default_grown_area_ratio times the rectangle (the
+// rectangle stopped short, e.g. of an L-shaped room) or the rectangle is missing. A rectangle gives up
+// the pixels of the grown rooms kept for the other doors. On a map whose dominant wall angle is at least
+// default_min_rotation (the layout's cells are axis-aligned) every door gets its rectangle. The growth runs on a
+// second thread while the rectangles are fitted (predict() is still safe to call from several threads).
+//
+// The rectangles:
+// 1. Orientation: the dominant wall direction (modulo 90 degrees) from the gradient directions of the occupied
+//    pixels; the map and its doors are rotated so that the walls run along x and y, and the rooms are rotated
+//    back at the end.
+// 2. Per door, in the door's frame (u along the door's wall, v into the unknown side):
+//    - the wall: the occupied pixels across the door; the room starts at the first unknown row behind it;
+//    - lateral extent: along the wall from the door in both directions while the wall continues (gaps up to
+//      default_wall_gap, e.g. open doorways) and the space just behind it is still unknown (a known pixel
+//      there is a perpendicular wall of an explored room);
+//    - doors on the same wall and the same side split their shared extent at the midpoint between them;
+//    - depth: per column of the extent, the unknown run behind the wall (past the column's own wall pixels
+//      within 0.15 m: a ragged or slightly tilted SLAM wall) up to the first known pixel; the
+//      median when enough columns end on a known pixel inside the known map's bounding box, else a prior: the
+//      depth of the explored rooms on the same side of the same wall, else of the other hidden rooms on that
+//      side, else the room's width (a square, as the thesis does).
+//    - overlapping rectangles of doors on perpendicular walls: the overlap goes to the door nearer to it (along
+//      that door's normal) and the other room ends where the overlap begins, if it keeps default_min_depth;
+//      other overlaps are cut halfway between the doors;
+// 3. The rectangle's unknown pixels connected to the door; pixels claimed by several rooms go to the nearest
+//    door.
+// Lateral extent and wall stubs: a stub ends the extent unless the wall goes on past it at another row (the side
+// wall of a door niche or of a step in the wall: no free space beyond it and wall pixels within its length).
+//
+// Every room, grown or rectangle (not on turned maps), is then clipped to the known map's outline beside it
+// (clipToKnownOutline, default_outline_reach): a room does not stick out of the building past the outer walls
+// its neighbours show; a side where nothing is known beyond the door is left open. Last, every room leaves out
+// the unknown cells within default_wall_margin of a wall cell: a wall the robot saw from one side shows only its
+// near face in a SLAM map, and the rest of its thickness is no room's. A negative margin (the default) is
+// estimated from the map (unseenWallThickness): 0 on maps that draw whole walls.
+//
+// Parameters: start_search_radius and the default_* keys (config/prediction.yaml), and the layout's
+// (config/layout.yaml) for the grown rooms; --debug-dir receives the layout's images.
+// terms: "rectangle" (1 when the rectangle was chosen, 0 the grown room); a grown room has the thesis's terms, a
+// rectangle "width", "depth" (metres), "depth_bounded" (1 when the depth came from the map, 0 from a prior) and
+// "rotation" (degrees the map was turned); every room "outline_clipped" (m^2 removed by the outline clip) and,
+// with a margin, "wall_margin" (metres) and "wall_margin_cut" (m^2 removed by it).
+
+#include <map>
+#include <string>
+
+#include "hidden_rooms/prediction/room_predictor.h"
+
+namespace hidden_rooms {
+
+class DefaultPredictor : public RoomPredictor {
+ public:
+  DefaultPredictor() = default;
+  std::string name() const override { return "default"; }
+  std::map<std::string, double> defaultParameters() const override;
+  PredictionResult predict(const PredictionRequest& request) const override;
+};
+
+// Dominant wall direction of a map, radians in [-pi/4, pi/4): the walls run along this angle and the one
+// perpendicular to it (image frame: x = column, y = row). 0 when the map has no occupied cells.
+double dominantWallAngle(const OccupancyGrid& map);
+
+// How much of the thickness of walls seen from one side a map does not show, metres: the most common length
+// (3 pixels to 1 m) of the runs along rows and columns that cross a wall seen from both sides (from a free cell,
+// starting and ending on an occupied cell, to the next free cell; the wall's inside may be unknown) less the median
+// occupied run between a free and an unknown cell (a wall seen from one side). 0 when the map draws whole walls,
+// or has fewer than 20 runs of either kind.
+double unseenWallThickness(const OccupancyGrid& map);
+
+// Clips a room (mask, image frame) to the known map's extent beside it: x to the known pixels of the rows within
+// `reach` pixels of the room's rows, y likewise from its columns, so that a room does not stick out of the
+// building past the outer walls its neighbours show. A limit is applied only when it lies at least `min_depth`
+// pixels beyond the door pixel (otherwise nothing is known on that side).
+void clipToKnownOutline(const cv::Mat1b& known, const cv::Point& door, int reach, int min_depth, cv::Mat1b* mask);
+
+}  // namespace hidden_rooms

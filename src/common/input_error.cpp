@@ -1,0 +1,13 @@
+#include "hidden_rooms/common/input_error.h"
+
+#include <cstdio>
+
+namespace hidden_rooms {
+
+std::string formatNumber(double value) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof(buffer), "%.10g", value);
+  return buffer;
+}
+
+}  // namespace hidden_rooms

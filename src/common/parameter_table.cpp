@@ -1,0 +1,15 @@
+#include "hidden_rooms/common/parameter_table.h"
+
+namespace hidden_rooms {
+
+void requireParameterInRange(const std::string& name, double value, const ParameterRange& range) {
+  const bool above_low = range.low_open ? value > range.low : value >= range.low;
+  const bool below_high = range.high_open ? value < range.high : value <= range.high;
+  if (above_low && below_high && (!range.integer || value == std::floor(value))) return;
+  throw InputError("parameters", "parameter '" + name + "' must be " + (range.integer ? "an integer " : "") +
+                                     "in " + (range.low_open ? "(" : "[") + formatNumber(range.low) + ", " +
+                                     formatNumber(range.high) + (range.high_open ? ")" : "]") + ", got " +
+                                     formatNumber(value));
+}
+
+}  // namespace hidden_rooms

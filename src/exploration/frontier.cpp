@@ -1,0 +1,207 @@
+#include "hidden_rooms/exploration/frontier.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include <opencv2/imgproc.hpp>
+
+#include "hidden_rooms/common/input_error.h"
+
+namespace hidden_rooms {
+
+FrontierMap findFrontiers(const OccupancyGrid& map, const FrontierOptions& options) {
+  FrontierMap result;
+  if (map.empty()) return result;
+  const int rows = map.height(), cols = map.width();
+  result.labels = cv::Mat1i::zeros(rows, cols);
+
+  // Unknown areas big enough to be worth exploring (4-connected, as the frontier test below looks at them).
+  // Uncertain cells (seen too rarely to be free or occupied) are as good as unknown.
+  const cv::Mat1b unknown = (map.cells < 0) | ((map.cells > options.free_threshold) & (map.cells < options.occupied_threshold));
+  cv::Mat1i unknown_labels, unknown_stats;
+  cv::Mat centroids;
+  cv::connectedComponentsWithStats(unknown, unknown_labels, unknown_stats, centroids, 4, CV_32S);
+  const auto significant_unknown = [&](int col, int row) {
+    if (col < 0 || row < 0 || col >= cols || row >= rows) return true;  // beyond the grid nothing is known
+    const int label = unknown_labels(row, col);
+    return label > 0 && unknown_stats(label, cv::CC_STAT_AREA) >= options.min_unknown_cells;
+  };
+
+  cv::Mat1b frontier_cells = cv::Mat1b::zeros(rows, cols);
+  for (int row = 0; row < rows; ++row)
+    for (int col = 0; col < cols; ++col) {
+      const int value = map.cells(row, col);
+      if (value < 0 || value > options.free_threshold) continue;
+      if (significant_unknown(col + 1, row) || significant_unknown(col - 1, row) ||
+          significant_unknown(col, row + 1) || significant_unknown(col, row - 1))
+        frontier_cells(row, col) = 255;
+    }
+
+  cv::Mat1i groups, stats;
+  const int group_count = cv::connectedComponentsWithStats(frontier_cells, groups, stats, centroids, 8, CV_32S);
+  std::vector<int> kept;
+  for (int label = 1; label < group_count; ++label)
+    if (stats(label, cv::CC_STAT_AREA) >= options.min_frontier_cells) kept.push_back(label);
+  std::stable_sort(kept.begin(), kept.end(), [&](int a, int b) {
+    return stats(a, cv::CC_STAT_AREA) > stats(b, cv::CC_STAT_AREA);
+  });
+  std::vector<int> new_label(group_count, 0);
+  for (size_t i = 0; i < kept.size(); ++i) new_label[kept[i]] = static_cast<int>(i) + 1;
+
+  result.frontiers.resize(kept.size());
+  for (size_t i = 0; i < kept.size(); ++i) result.frontiers[i].label = static_cast<int>(i) + 1;
+  for (int row = 0; row < rows; ++row)
+    for (int col = 0; col < cols; ++col) {
+      const int label = new_label[groups(row, col)];
+      if (label == 0) continue;
+      result.labels(row, col) = label;
+      Frontier& frontier = result.frontiers[label - 1];
+      frontier.cells.emplace_back(col, row);
+      frontier.centroid += map.cellCentre(col, row);
+    }
+  for (Frontier& frontier : result.frontiers) frontier.centroid /= static_cast<double>(frontier.cells.size());
+  return result;
+}
+
+bool Blacklist::contains(const Point2& point) const {
+  return std::any_of(points.begin(), points.end(),
+                     [&](const Point2& listed) { return (listed - point).norm() <= radius; });
+}
+
+bool Blacklist::add(const Point2& point, GoalOutcome outcome) {
+  points.push_back(point);
+  if (outcome == GoalOutcome::kRobotStuck) {
+    stuck_points.push_back(point);
+    return true;
+  }
+  const auto near = [&](const Point2& place) { return (place - point).norm() <= radius; };
+  if (outcome != GoalOutcome::kFailed || std::any_of(retried_points.begin(), retried_points.end(), near)) return false;
+  failed_points.push_back(point);
+  return true;
+}
+
+namespace {
+
+// Removes every occurrence of each of `released` from `points`; returns how many `released` there were.
+size_t removePoints(std::vector<Point2>* released, std::vector<Point2>* points) {
+  for (const Point2& place : *released)
+    points->erase(std::remove(points->begin(), points->end(), place), points->end());
+  const size_t count = released->size();
+  released->clear();
+  return count;
+}
+
+}  // namespace
+
+size_t Blacklist::releaseStuck() { return removePoints(&stuck_points, &points); }
+
+size_t Blacklist::releaseFailed() {
+  retried_points.insert(retried_points.end(), failed_points.begin(), failed_points.end());
+  return removePoints(&failed_points, &points);
+}
+
+void validate(const BlockedPassagesOptions& options) {
+  const auto require = [](bool ok, const std::string& what) {
+    if (!ok) throw InputError("explorer options", what);
+  };
+  require(options.failures >= 0, "blocked_passage_failures must be >= 0");
+  for (const double value : {options.same_place, options.same_direction, options.skip, options.length, options.radius})
+    require(std::isfinite(value) && value >= 0.0, "blocked passage distances and angles must be >= 0");
+  require(options.skip < options.length, "the blocked stretch must start (skip) before it ends (length)");
+}
+
+BlockedPassages::BlockedPassages(const BlockedPassagesOptions& options) : options_(options) { validate(options_); }
+
+bool BlockedPassages::addFailure(const Point2& robot, const std::vector<Point2>& path) {
+  if (options_.failures <= 0 || path.empty()) return false;
+  const auto here = [&](const Point2& place) { return (place - robot).norm() <= options_.same_place; };
+  if (std::any_of(wedged_.begin(), wedged_.end(), here)) return false;
+  // The stretch: path points between skip and length metres along the path from the point nearest the robot.
+  size_t nearest = 0;
+  for (size_t i = 1; i < path.size(); ++i)
+    if ((path[i] - robot).norm() < (path[nearest] - robot).norm()) nearest = i;
+  Failure failure{robot, Point2::Zero(), {}, false};
+  double along = 0.0;
+  for (size_t i = nearest + 1; i < path.size() && along <= options_.length; ++i) {
+    along += (path[i] - path[i - 1]).norm();
+    if (along >= options_.skip && along <= options_.length) failure.stretch.push_back(path[i]);
+  }
+  if (failure.stretch.empty() || (failure.stretch.back() - robot).norm() < 1e-9) return false;
+  failure.direction = (failure.stretch.back() - robot).normalized();
+
+  const size_t blocked_before = blocked_.size();
+  const auto from_here = [&](const Failure& other) { return here(other.robot); };
+  const double agreement = std::cos(options_.same_direction);
+  const bool wedged = std::any_of(failures_.begin(), failures_.end(), [&](const Failure& other) {
+    return from_here(other) && other.direction.dot(failure.direction) < agreement;
+  });
+  if (wedged) {
+    wedged_.push_back(robot);
+    failures_.erase(std::remove_if(failures_.begin(), failures_.end(), from_here), failures_.end());
+  } else {
+    failures_.push_back(failure);
+    if (std::count_if(failures_.begin(), failures_.end(), from_here) >= options_.failures)
+      for (Failure& other : failures_)
+        if (from_here(other)) other.blocking = true;
+  }
+  collectBlocked();
+  return blocked_.size() != blocked_before;
+}
+
+void BlockedPassages::collectBlocked() {
+  blocked_.clear();
+  for (const Failure& failure : failures_)
+    if (failure.blocking) blocked_.insert(blocked_.end(), failure.stretch.begin(), failure.stretch.end());
+}
+
+size_t BlockedPassages::releaseOnce() {
+  if (released_ || blocked_.empty()) return 0;
+  released_ = true;
+  const size_t released = blocked_.size();
+  failures_.clear();
+  blocked_.clear();
+  return released;
+}
+
+std::optional<FrontierGoal> nearestFrontierGoal(const FrontierMap& frontiers, const GridPlanner& planner,
+                                                const Blacklist& blacklist, const FrontierOptions& options,
+                                                const std::optional<Point2>& previous, double hysteresis) {
+  const OccupancyGrid& map = planner.map();
+  if (map.empty() || frontiers.frontiers.empty() || planner.startCell().x < 0) return std::nullopt;
+  const int reach = static_cast<int>(std::floor(options.goal_reach / map.resolution));
+  const cv::Mat1b& roomy = planner.roomy();  // goals keep robot_radius from obstacles
+
+  const Point2 robot = map.cellCentre(planner.startCell().x, planner.startCell().y);
+  const auto acceptable = [&](const Point2& position) {
+    return (position - robot).norm() >= options.min_goal_distance && !blacklist.contains(position);
+  };
+  // Per cell, the frontier that claims it (the first one found within reach); cells are visited once.
+  cv::Mat1i claimed = cv::Mat1i::zeros(map.height(), map.width());
+  std::optional<FrontierGoal> best;
+  for (const Frontier& frontier : frontiers.frontiers) {
+    for (const cv::Point& cell : frontier.cells) {
+      for (int row = std::max(0, cell.y - reach); row <= std::min(map.height() - 1, cell.y + reach); ++row)
+        for (int col = std::max(0, cell.x - reach); col <= std::min(map.width() - 1, cell.x + reach); ++col) {
+          if (claimed(row, col) != 0 || roomy(row, col) == 0) continue;
+          if ((col - cell.x) * (col - cell.x) + (row - cell.y) * (row - cell.y) > reach * reach) continue;
+          claimed(row, col) = frontier.label;
+          const double cost = planner.costTo(col, row);
+          if (!std::isfinite(cost) || (best && cost >= best->cost)) continue;
+          const Point2 position = map.cellCentre(col, row);
+          if (!acceptable(position)) continue;
+          best = FrontierGoal{frontier.label, {col, row}, position, cost};
+        }
+    }
+  }
+  if (!best || !previous) return best;
+
+  // Keep the previous goal while a frontier still claims it and it is not much dearer than the best.
+  int col = 0, row = 0;
+  if (!map.cellOf(*previous, &col, &row) || claimed(row, col) == 0 || blacklist.contains(*previous)) return best;
+  const double cost = planner.costTo(col, row);
+  if (!std::isfinite(cost) || cost > best->cost + hysteresis) return best;
+  return FrontierGoal{claimed(row, col), {col, row}, map.cellCentre(col, row), cost};
+}
+
+}  // namespace hidden_rooms

@@ -1,0 +1,417 @@
+#include "hidden_rooms/exploration/path_follower.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "hidden_rooms/common/input_error.h"
+
+namespace hidden_rooms {
+
+namespace {
+
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
+// `point` (map frame) in the frame of a robot at `pose`.
+Point2 toRobotFrame(const Pose2& pose, const Point2& point) { return transformPoint(invertPose(pose), point); }
+
+}  // namespace
+
+void validate(const PathFollowerOptions& options) {
+  const auto positive = [](double value, const char* name) {
+    if (!std::isfinite(value) || value <= 0.0) throw InputError("explorer options", std::string(name) + " must be positive");
+  };
+  const auto non_negative = [](double value, const char* name) {
+    if (!std::isfinite(value) || value < 0.0) throw InputError("explorer options", std::string(name) + " must be >= 0");
+  };
+  positive(options.max_linear_velocity, "max_linear_velocity");
+  positive(options.max_angular_velocity, "max_angular_velocity");
+  positive(options.lookahead, "lookahead");
+  positive(options.goal_tolerance, "goal_tolerance");
+  positive(options.rotate_in_place_angle, "rotate_in_place_angle");
+  positive(options.heading_gain, "heading_gain");
+  positive(options.footprint_length, "footprint_length");
+  positive(options.footprint_width, "footprint_width");
+  non_negative(options.side_margin, "side_margin");
+  non_negative(options.stop_distance, "stop_distance");
+  positive(options.deceleration, "deceleration");
+  positive(options.stall_timeout, "stall_timeout");
+  non_negative(options.stall_distance, "stall_distance");
+  non_negative(options.stall_angle, "stall_angle");
+  non_negative(options.backoff_time, "backoff_time");
+  non_negative(options.backoff_velocity, "backoff_velocity");
+  non_negative(options.creep_velocity, "creep_velocity");
+  non_negative(options.arc_horizon, "arc_horizon");
+  non_negative(options.doorway_distance, "doorway_distance");
+  non_negative(options.doorway_angular_velocity, "doorway_angular_velocity");
+  non_negative(options.recovery_rotate_time, "recovery_rotate_time");
+  positive(options.progress_timeout, "progress_timeout");
+  non_negative(options.progress_distance, "progress_distance");
+  if (options.max_recoveries < 0) throw InputError("explorer options", "max_recoveries must be >= 0");
+}
+
+const char* toString(FollowerState state) {
+  switch (state) {
+    case FollowerState::kIdle: return "idle";
+    case FollowerState::kFollowing: return "following";
+    case FollowerState::kBackingOff: return "backing off";
+    case FollowerState::kRecoveryRotating: return "rotating (recovery)";
+    case FollowerState::kGoalReached: return "goal reached";
+    case FollowerState::kFailed: return "failed";
+  }
+  return "unknown";
+}
+
+std::vector<Point2> obstaclePoints(const RangeScan& scan, int* skipped) {
+  std::vector<Point2> points;
+  points.reserve(scan.ranges.size());
+  int invalid = 0;
+  const double c = std::cos(scan.sensor_pose.yaw), s = std::sin(scan.sensor_pose.yaw);
+  for (size_t k = 0; k < scan.ranges.size(); ++k) {
+    const double range = scan.ranges[k];
+    if (!std::isfinite(range) || !scan.valid(k)) {
+      ++invalid;
+      continue;
+    }
+    const double angle = scan.angle_min + static_cast<double>(k) * scan.angle_increment;
+    const double x = range * std::cos(angle), y = range * std::sin(angle);
+    points.emplace_back(scan.sensor_pose.x + c * x - s * y, scan.sensor_pose.y + s * x + c * y);
+  }
+  if (skipped != nullptr) *skipped = invalid;
+  return points;
+}
+
+void ObstacleMemory::add(const std::vector<Point2>& points, const Pose2& pose, double time) {
+  scans_.erase(std::remove_if(scans_.begin(), scans_.end(),
+                              [&](const Scan& scan) { return scan.time < time - duration_ || scan.time > time; }),
+               scans_.end());
+  Scan scan;
+  scan.time = time;
+  scan.points.reserve(points.size());
+  const double c = std::cos(pose.yaw), s = std::sin(pose.yaw);
+  for (const Point2& point : points)
+    if (point.allFinite()) scan.points.emplace_back(pose.x + c * point.x() - s * point.y(), pose.y + s * point.x() + c * point.y());
+  scans_.push_back(std::move(scan));
+}
+
+std::vector<Point2> ObstacleMemory::points(const Pose2& pose) const {
+  std::vector<Point2> result;
+  for (const Scan& scan : scans_)
+    for (const Point2& point : scan.points) result.push_back(toRobotFrame(pose, point));
+  return result;
+}
+
+namespace {
+
+// Free distance beyond the footprint's front (`direction` +1) or rear (-1) within its lane. Points beside the
+// footprint in the lane's side margins do not count (driving straight does not bring them closer); points inside
+// the footprint's half on that side give 0.
+double laneClearance(const std::vector<Point2>& obstacles, const PathFollowerOptions& options, double direction) {
+  const double half_length = 0.5 * options.footprint_length, half_width = 0.5 * options.footprint_width;
+  const double half_lane = half_width + options.side_margin;
+  double clearance = kInfinity;
+  for (const Point2& point : obstacles) {
+    const double along = direction * point.x();
+    if (!point.allFinite() || std::abs(point.y()) > half_lane || along < 0.0 || (along == 0.0 && direction < 0))
+      continue;
+    if (along > half_length)
+      clearance = std::min(clearance, along - half_length);
+    else if (std::abs(point.y()) <= half_width)
+      clearance = 0.0;
+  }
+  return clearance;
+}
+
+}  // namespace
+
+double frontClearance(const std::vector<Point2>& obstacles, const PathFollowerOptions& options) {
+  return laneClearance(obstacles, options, 1.0);
+}
+
+double rearClearance(const std::vector<Point2>& obstacles, const PathFollowerOptions& options) {
+  return laneClearance(obstacles, options, -1.0);
+}
+
+PathFollower::PathFollower(const PathFollowerOptions& options) : options_(options) { validate(options_); }
+
+void PathFollower::setPath(const std::vector<Point2>& path, double time) {
+  path_ = path;
+  closest_index_ = 0;
+  recoveries_ = 0;
+  recoveries_without_motion_ = 0;
+  held_ = false;
+  anchor_set_ = false;
+  progress_time_ = time;
+  best_remaining_ = kInfinity;
+  state_ = path_.empty() ? FollowerState::kIdle : FollowerState::kFollowing;
+}
+
+void PathFollower::updatePath(const std::vector<Point2>& path) {
+  if (path.empty()) return;
+  path_ = path;
+  closest_index_ = 0;
+}
+
+void PathFollower::stop() {
+  path_.clear();
+  state_ = FollowerState::kIdle;
+}
+
+void PathFollower::hold(double time) {
+  if (held_) return;
+  held_ = true;
+  held_since_ = time;
+}
+
+bool PathFollower::withinStall(const Pose2& pose, const Pose2& since) const {
+  return std::hypot(pose.x - since.x, pose.y - since.y) <= options_.stall_distance &&
+         std::abs(wrapAngle(pose.yaw - since.yaw)) <= options_.stall_angle;
+}
+
+double PathFollower::remainingLength(const Pose2& pose) {
+  // The closest path point, searched from the last one on (the robot does not go back along its path); a
+  // window keeps a path that passes near itself from being skipped.
+  const Point2 position(pose.x, pose.y);
+  double best = kInfinity;
+  size_t best_index = closest_index_;
+  double along = 0.0;
+  for (size_t i = closest_index_; i < path_.size(); ++i) {
+    if (i > closest_index_) along += (path_[i] - path_[i - 1]).norm();
+    if (along > 2.0 * options_.lookahead + 1.0) break;
+    const double d = (path_[i] - position).norm();
+    if (d < best) {
+      best = d;
+      best_index = i;
+    }
+  }
+  closest_index_ = best_index;
+  double remaining = best;
+  for (size_t i = closest_index_ + 1; i < path_.size(); ++i) remaining += (path_[i] - path_[i - 1]).norm();
+  return remaining;
+}
+
+FollowerStep PathFollower::update(const Pose2& pose, const std::vector<Point2>& obstacles, double time) {
+  if (held_) {  // the held time does not count: timers move on by it, the stall watch starts afresh
+    const double pause = std::max(0.0, time - held_since_);
+    progress_time_ += pause;
+    recovery_until_ += pause;
+    anchor_set_ = false;
+    held_ = false;
+  }
+  FollowerStep step;
+  step.front_clearance = frontClearance(obstacles, options_);
+  if (state_ == FollowerState::kIdle || state_ == FollowerState::kGoalReached || state_ == FollowerState::kFailed ||
+      path_.empty()) {
+    step.state = state_;
+    return step;
+  }
+
+  // Goal and progress.
+  const Point2 position(pose.x, pose.y);
+  if ((path_.back() - position).norm() <= options_.goal_tolerance) {
+    state_ = step.state = FollowerState::kGoalReached;
+    return step;
+  }
+  const double remaining = remainingLength(pose);
+  if (remaining <= best_remaining_ - options_.progress_distance || !std::isfinite(best_remaining_)) {
+    best_remaining_ = remaining;
+    progress_time_ = time;
+  }
+  if (time - progress_time_ > options_.progress_timeout) {
+    state_ = step.state = FollowerState::kFailed;
+    return step;
+  }
+
+  // Recovery in progress.
+  if (state_ == FollowerState::kBackingOff) {
+    if (time < recovery_until_ && rearClearance(obstacles, options_) > options_.stop_distance) {
+      step.command.linear = -options_.backoff_velocity;
+      step.state = state_;
+      return step;
+    }
+    state_ = FollowerState::kRecoveryRotating;
+    recovery_until_ = time + options_.recovery_rotate_time;
+  }
+  if (state_ == FollowerState::kRecoveryRotating) {
+    if (time < recovery_until_) {
+      step.command.angular = recovery_turn_sign_ * options_.max_angular_velocity;
+      step.state = state_;
+      return step;
+    }
+    state_ = FollowerState::kFollowing;
+    anchor_set_ = false;
+    last_recovery_moved_ = !withinStall(pose, recovery_start_pose_);
+    if (!last_recovery_moved_) ++recoveries_without_motion_;
+  }
+
+  // Stall watch: no motion for stall_timeout while following starts a recovery (or fails after too many).
+  if (!anchor_set_ || !withinStall(pose, anchor_pose_)) {
+    anchor_pose_ = pose;
+    anchor_time_ = time;
+    anchor_set_ = true;
+  } else if (time - anchor_time_ > options_.stall_timeout) {
+    if (recoveries_ >= options_.max_recoveries) {
+      state_ = step.state = FollowerState::kFailed;
+      return step;
+    }
+    ++recoveries_;
+    if (!last_recovery_moved_ && withinStall(pose, recovery_start_pose_)) {
+      recovery_turn_sign_ = -recovery_turn_sign_;  // that turn was blocked: the other way
+    } else {
+      // Turn towards the side with more room: the mean lateral position of nearby points tells the crowded side.
+      double lateral = 0.0;
+      for (const Point2& point : obstacles)
+        if (point.allFinite() && point.norm() < 1.5) lateral += point.y();
+      recovery_turn_sign_ = lateral > 0.0 ? -1.0 : 1.0;
+    }
+    recovery_start_pose_ = pose;
+    state_ = FollowerState::kBackingOff;
+    recovery_until_ = time + options_.backoff_time;
+    anchor_set_ = false;
+    step.state = state_;
+    if (rearClearance(obstacles, options_) > options_.stop_distance)
+      step.command.linear = -options_.backoff_velocity;
+    return step;
+  }
+  return follow(pose, obstacles, step.front_clearance);
+}
+
+bool PathFollower::arcHitsObstacle(const std::vector<Point2>& obstacles, double linear, double angular,
+                                   double max_distance) const {
+  if (options_.arc_horizon <= 0.0 || linear <= 0.0) return false;
+  const double horizon = std::min(options_.arc_horizon, max_distance / linear);
+  const double half_length = 0.5 * options_.footprint_length, half_width = 0.5 * options_.footprint_width;
+  const double reach = linear * horizon + std::hypot(half_length, half_width) + options_.side_margin;
+  const auto inside = [&](const Point2& point, double margin) {
+    return std::abs(point.x()) <= half_length + margin && std::abs(point.y()) <= half_width + margin;
+  };
+  std::vector<Point2> near;
+  for (const Point2& point : obstacles)
+    if (point.allFinite() && point.norm() <= reach) near.push_back(point);
+  // Already within the margin of something (a tight door): the arc may not come closer than 70% of the present
+  // gap, or nothing could move.
+  double gap = std::numeric_limits<double>::infinity();
+  for (const Point2& point : near)
+    gap = std::min(gap, std::hypot(std::max(0.0, std::abs(point.x()) - half_length),
+                                   std::max(0.0, std::abs(point.y()) - half_width)));
+  const double margin = std::min(options_.side_margin, 0.7 * gap);
+  constexpr double kStep = 0.1;  // seconds between checked poses
+  for (double t = std::min(kStep, horizon); t <= horizon + 1e-9; t += kStep) {
+    // Unicycle pose after t seconds from the origin.
+    const double yaw = angular * t;
+    const double x = std::abs(angular) > 1e-6 ? linear / angular * std::sin(yaw) : linear * t;
+    const double y = std::abs(angular) > 1e-6 ? linear / angular * (1.0 - std::cos(yaw)) : 0.0;
+    const double c = std::cos(yaw), s = std::sin(yaw);
+    for (const Point2& point : near) {
+      const double dx = point.x() - x, dy = point.y() - y;
+      if (inside(Point2(c * dx + s * dy, -s * dx + c * dy), margin)) return true;
+    }
+  }
+  return false;
+}
+
+bool PathFollower::inDoorway(const std::vector<Point2>& obstacles) const {
+  const double half_length = 0.5 * options_.footprint_length, half_width = 0.5 * options_.footprint_width;
+  bool left = false, right = false;
+  for (const Point2& point : obstacles) {
+    if (!point.allFinite() || std::abs(point.x()) > half_length) continue;
+    if (point.y() > half_width && point.y() <= half_width + options_.doorway_distance) left = true;
+    if (point.y() < -half_width && point.y() >= -half_width - options_.doorway_distance) right = true;
+  }
+  return left && right;
+}
+
+VelocityCommand PathFollower::turnInPlace(double angular, const std::vector<Point2>& obstacles,
+                                          double front_clearance) const {
+  const double half_length = 0.5 * options_.footprint_length, half_width = 0.5 * options_.footprint_width;
+  const double swept_radius = std::hypot(half_length, half_width) + options_.side_margin;
+  bool front = false, rear = false;
+  for (const Point2& point : obstacles) {
+    if (!point.allFinite() || point.norm() >= swept_radius) continue;
+    if (std::abs(point.x()) <= half_length && std::abs(point.y()) <= half_width) continue;  // inside: not the turn's fault
+    (point.x() >= 0.0 ? front : rear) = true;
+  }
+  const bool ahead_free = front_clearance > options_.stop_distance;
+  VelocityCommand command;
+  command.angular = angular;
+  if (front && !rear) {
+    if (rearClearance(obstacles, options_) > options_.stop_distance) command.linear = -options_.creep_velocity;
+  } else if (rear && !front) {
+    if (ahead_free) command.linear = options_.creep_velocity;
+  } else if (front && rear && ahead_free) {
+    // Hemmed in on both halves (in a doorway): leave straight ahead before turning.
+    command.linear = options_.creep_velocity;
+    command.angular = 0.0;
+  }
+  return command;
+}
+
+FollowerStep PathFollower::follow(const Pose2& pose, const std::vector<Point2>& obstacles, double clearance) {
+  FollowerStep step;
+  step.state = state_;
+  step.front_clearance = clearance;
+  // Pursued point: the first path point at least `lookahead` from the robot after the closest one, else the end.
+  const Point2 position(pose.x, pose.y);
+  Point2 target = path_.back();
+  for (size_t i = closest_index_; i < path_.size(); ++i)
+    if ((path_[i] - position).norm() >= options_.lookahead) {
+      target = path_[i];
+      break;
+    }
+  const Point2 local = toRobotFrame(pose, target);
+  const double heading_error = std::atan2(local.y(), local.x());
+  if (std::abs(heading_error) > options_.rotate_in_place_angle) {
+    step.command = turnInPlace(std::clamp(options_.heading_gain * heading_error, -options_.max_angular_velocity,
+                                          options_.max_angular_velocity),
+                               obstacles, clearance);
+    return step;
+  }
+  // Speed: the maximum, less when the heading is off, capped by the free space ahead and the distance to the end.
+  const double free_ahead = std::max(0.0, clearance - options_.stop_distance);
+  const double to_goal = (path_.back() - position).norm();
+  double linear = options_.max_linear_velocity * (1.0 - 0.5 * std::abs(heading_error) / options_.rotate_in_place_angle);
+  linear = std::min({linear, std::sqrt(2.0 * options_.deceleration * free_ahead),
+                     std::sqrt(2.0 * options_.deceleration * to_goal) + 0.05});
+  const double squared_distance = std::max(local.squaredNorm(), 1e-6);
+  const double curvature = 2.0 * local.y() / squared_distance;
+  double angular = linear * curvature;
+  if (std::abs(angular) > options_.max_angular_velocity) {
+    angular = std::copysign(options_.max_angular_velocity, angular);
+    linear = std::abs(angular / curvature);
+  }
+  // Steering around what the laser sees: when the pure-pursuit arc would touch something (checked no further
+  // than the path's end), the nearest turn rate whose arc is clear (at this speed, else at half of it). When none
+  // is, the command stays: the speed cap above stops the robot in front of what lies ahead.
+  const double check_distance = remainingLength(pose) + 0.1;
+  if (linear > 1e-3 && arcHitsObstacle(obstacles, linear, angular, check_distance)) {
+    bool found = false;
+    for (const double speed : {linear, 0.5 * linear}) {
+      for (int k = 1; k <= 8 && !found; ++k)
+        for (const double sign : {1.0, -1.0}) {
+          const double candidate = std::clamp(angular + sign * k * 0.125 * options_.max_angular_velocity,
+                                              -options_.max_angular_velocity, options_.max_angular_velocity);
+          if (!arcHitsObstacle(obstacles, speed, candidate, check_distance)) {
+            linear = speed;
+            angular = candidate;
+            found = true;
+            break;
+          }
+        }
+      if (found) break;
+    }
+  }
+  // In a doorway (something beside both sides within doorway_distance), turn slowly: the rear would swing into
+  // the frame, where the laser does not look.
+  if (inDoorway(obstacles)) angular = std::clamp(angular, -options_.doorway_angular_velocity, options_.doorway_angular_velocity);
+  if (linear <= 1e-3) {
+    // Blocked ahead: still turn towards the path (the stall watch starts a recovery if nothing changes).
+    angular = std::clamp(options_.heading_gain * heading_error, -options_.max_angular_velocity,
+                         options_.max_angular_velocity);
+    linear = 0.0;
+  }
+  step.command.linear = linear;
+  step.command.angular = angular;
+  return step;
+}
+
+}  // namespace hidden_rooms

@@ -1,0 +1,282 @@
+#include "hidden_rooms/mapping/rbpf_mapper.h"
+
+#include <algorithm>
+#include <cmath>
+#include <exception>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+
+#include <mrpt/config/CConfigFile.h>
+#include <mrpt/core/format.h>
+#include <mrpt/maps/CMultiMetricMap.h>
+#include <mrpt/maps/COccupancyGridMap2D.h>
+#include <mrpt/obs/CActionCollection.h>
+#include <mrpt/obs/CActionRobotMovement2D.h>
+#include <mrpt/obs/CObservation2DRangeScan.h>
+#include <mrpt/obs/CSensoryFrame.h>
+#include <mrpt/poses/CPose2D.h>
+#include <mrpt/poses/CPose3DPDFParticles.h>
+#include <mrpt/poses/CPosePDFGaussian.h>
+#include <mrpt/random/RandomGenerators.h>
+#include <mrpt/slam/CMetricMapBuilderRBPF.h>
+
+#include "hidden_rooms/common/input_error.h"
+
+namespace hidden_rooms {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+mrpt::poses::CPose2D toMrpt(const Pose2& pose) { return mrpt::poses::CPose2D(pose.x, pose.y, pose.yaw); }
+Pose2 fromMrpt(const mrpt::math::TPose3D& pose) { return {pose.x, pose.y, pose.yaw}; }
+
+// The double a float was written from (0.05f -> 0.05): MRPT keeps the grid's geometry in floats.
+double shortest(float value) { return std::stod(mrpt::format("%.7g", static_cast<double>(value))); }
+
+bool finite(const Pose2& pose) { return std::isfinite(pose.x) && std::isfinite(pose.y) && std::isfinite(pose.yaw); }
+
+// The odometry motion model from the ini's [MotionModel] section (MRPT has no loader for it).
+mrpt::obs::CActionRobotMovement2D::TMotionModelOptions readMotionModel(const mrpt::config::CConfigFileBase& ini,
+                                                                       const std::string& file) {
+  mrpt::obs::CActionRobotMovement2D::TMotionModelOptions model;
+  model.modelSelection = mrpt::obs::CActionRobotMovement2D::mmGaussian;
+  auto& g = model.gaussianModel;
+  const std::string section = "MotionModel";
+  g.a1 = ini.read_double(section, "a1", g.a1);
+  g.a2 = ini.read_double(section, "a2", g.a2);
+  g.a3 = ini.read_double(section, "a3", g.a3);
+  g.a4 = ini.read_double(section, "a4", g.a4);
+  g.minStdXY = ini.read_double(section, "minStdXY", g.minStdXY);
+  g.minStdPHI = ini.read_double(section, "minStdPHI_deg", g.minStdPHI * 180.0 / kPi) * kPi / 180.0;
+  for (double value : {g.a1, g.a2, g.a3, g.a4, g.minStdXY, g.minStdPHI})
+    if (!std::isfinite(value) || value < 0.0) throw InputError(file, "[MotionModel] values must be zero or positive");
+  return model;
+}
+
+// Insertion options of the published grid ([PublishedMap], see config/rbpf.ini): those of the filter's grid with
+// its own update certainties.
+mrpt::maps::COccupancyGridMap2D::TInsertionOptions readPublishedInsertion(
+    const mrpt::config::CConfigFileBase& ini, const std::string& file,
+    mrpt::maps::COccupancyGridMap2D::TInsertionOptions insertion) {
+  const std::string section = "PublishedMap";
+  insertion.maxOccupancyUpdateCertainty =
+      ini.read_float(section, "maxOccupancyUpdateCertainty", insertion.maxOccupancyUpdateCertainty);
+  insertion.maxFreenessUpdateCertainty =
+      ini.read_float(section, "maxFreenessUpdateCertainty", insertion.maxFreenessUpdateCertainty);
+  const auto certain = [](float value) { return value > 0.5f && value < 1.0f; };
+  if (!certain(insertion.maxOccupancyUpdateCertainty) ||
+      !(insertion.maxFreenessUpdateCertainty == 0.0f || certain(insertion.maxFreenessUpdateCertainty)))
+    throw InputError(file, "[PublishedMap] certainties must be in (0.5, 1) (maxFreenessUpdateCertainty 0: as occupancy)");
+  return insertion;
+}
+
+}  // namespace
+
+struct RbpfMapper::Impl {
+  std::unique_ptr<mrpt::slam::CMetricMapBuilderRBPF> builder;
+  mrpt::obs::CActionRobotMovement2D::TMotionModelOptions motion_model;
+  bool started = false;
+  Pose2 last_odometry;
+  int added = 0;
+  int inserted = 0;
+
+  // The published map: every inserted scan drawn again along the path of the particle whose grid MRPT calls the
+  // most likely one, with the [PublishedMap] certainties (as gmapping renders its map from the best particle's
+  // trajectory). Scans and their index in the particles' paths, in insertion order.
+  mrpt::maps::COccupancyGridMap2D::TInsertionOptions published_insertion;
+  std::vector<mrpt::obs::CObservation2DRangeScan::Ptr> inserted_scans;
+  std::vector<size_t> inserted_path_index;
+  // Cache of the last rendering: the grid and the poses it drew the first scans at (a new best particle whose
+  // path starts with the same poses only adds the new scans).
+  mutable std::optional<mrpt::maps::COccupancyGridMap2D> rendered;
+  mutable std::vector<mrpt::math::TPose3D> rendered_poses;
+
+  size_t mappedParticle() const;
+  const mrpt::maps::COccupancyGridMap2D& publishedGrid() const;
+};
+
+RbpfMapper::RbpfMapper(const RbpfMapperOptions& options) : impl_(std::make_unique<Impl>()) {
+  const std::string& file = options.config_file;
+  if (file.empty()) throw InputError("rbpf config", "no ini file given");
+  if (!std::filesystem::is_regular_file(file) || !std::ifstream(file).good())
+    throw InputError(file, "cannot read the file");
+  mrpt::slam::CMetricMapBuilderRBPF::TConstructionOptions construction;
+  try {
+    mrpt::config::CConfigFile ini(file);
+    if (!ini.sectionExists(options.section)) throw InputError(file, "no section [" + options.section + "]");
+    construction.loadFromConfigFile(ini, options.section);
+    impl_->motion_model = readMotionModel(ini, file);
+    for (const auto& initializer : construction.mapsInitializers)
+      if (const auto* grid = dynamic_cast<const mrpt::maps::COccupancyGridMap2D::TMapDefinition*>(initializer.get())) {
+        impl_->published_insertion = readPublishedInsertion(ini, file, grid->insertionOpts);
+        break;
+      }
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::exception& error) {
+    // MRPT's messages carry a stack trace; its first line names the missing or bad key.
+    std::string message = error.what();
+    const size_t newline = message.find('\n');
+    if (newline != std::string::npos) message = message.substr(0, newline);
+    throw InputError(file, "bad MRPT RBPF options: " + message);
+  }
+  if (construction.PF_options.sampleSize == 0) throw InputError(file, "sampleSize must be positive");
+  if (!(construction.insertionLinDistance >= 0.0f) || !(construction.localizeLinDistance >= 0.0f))
+    throw InputError(file, "insertion and localize distances must be zero or positive");
+  mrpt::random::getRandomGenerator().randomize(options.seed);
+  try {
+    impl_->builder = std::make_unique<mrpt::slam::CMetricMapBuilderRBPF>(construction);
+  } catch (const std::exception& error) {
+    std::string message = error.what();
+    throw InputError(file, "MRPT cannot build the filter: " + message.substr(0, message.find('\n')));
+  }
+  const mrpt::maps::CMultiMetricMap* maps = impl_->builder->getCurrentlyBuiltMetricMap();
+  if (maps == nullptr || maps->countMapsByClass<mrpt::maps::COccupancyGridMap2D>() == 0)
+    throw InputError(file, "the maps must include an occupancy grid (occupancyGrid_count = 1)");
+}
+
+RbpfMapper::~RbpfMapper() = default;
+
+bool RbpfMapper::addScan(const Pose2& odometry, const RangeScan& scan) {
+  if (scan.ranges.empty()) throw InputError("scan", "has no beams");
+  if (!finite(scan.sensor_pose) || !std::isfinite(scan.angle_min) || !std::isfinite(scan.angle_increment) ||
+      scan.angle_increment == 0.0 || !(scan.range_max > 0.0))
+    throw InputError("scan", "non-finite pose or bad beam geometry");
+  // Scan as MRPT wants it: beams from -aperture/2 to +aperture/2 counter-clockwise, the sensor yawed to the
+  // middle of the scan (as toMrptScan does for ROS messages).
+  const size_t n = scan.ranges.size();
+  const bool reversed = scan.angle_increment < 0.0;
+  const double aperture = std::abs(scan.angle_increment) * static_cast<double>(n - 1);
+  const double first = reversed ? scan.angle_min + scan.angle_increment * static_cast<double>(n - 1) : scan.angle_min;
+  mrpt::obs::CObservation2DRangeScan observation;
+  observation.aperture = static_cast<float>(n > 1 ? aperture : 0.0);
+  observation.rightToLeft = true;
+  observation.maxRange = static_cast<float>(scan.range_max);
+  observation.sensorPose = mrpt::poses::CPose3D(mrpt::poses::CPose2D(
+      scan.sensor_pose.x, scan.sensor_pose.y, scan.sensor_pose.yaw + first + 0.5 * aperture));
+  observation.resizeScan(n);
+  for (size_t i = 0; i < n; ++i) {
+    const size_t k = reversed ? n - 1 - i : i;
+    const bool valid = std::isfinite(scan.ranges[k]) && scan.valid(k);
+    observation.setScanRange(i, valid ? scan.ranges[k] : static_cast<float>(scan.range_max));
+    observation.setScanRangeValidity(i, valid);
+  }
+  return addScan(odometry, observation);
+}
+
+bool RbpfMapper::addScan(const Pose2& odometry, const mrpt::obs::CObservation2DRangeScan& scan) {
+  if (scan.getScanSize() == 0) throw InputError("scan", "has no beams");
+  if (!finite(odometry)) throw InputError("scan", "non-finite odometry pose");
+  Impl& impl = *impl_;
+  if (!impl.started) {
+    mrpt::poses::CPosePDFGaussian start(toMrpt(odometry));
+    impl.builder->initialize(mrpt::maps::CSimpleMap(), &start);
+    impl.last_odometry = odometry;
+    impl.started = true;
+  }
+  auto observation = std::make_shared<mrpt::obs::CObservation2DRangeScan>(scan);
+  mrpt::obs::CSensoryFrame frame;
+  frame.insert(observation);
+
+  // Odometry increment since the last scan, in the robot frame.
+  mrpt::obs::CActionRobotMovement2D movement;
+  movement.computeFromOdometry(toMrpt(odometry) - toMrpt(impl.last_odometry), impl.motion_model);
+  mrpt::obs::CActionCollection actions;
+  actions.insert(movement);
+  impl.last_odometry = odometry;
+
+  impl.builder->processActionObservation(actions, frame);
+  ++impl.added;
+  const bool was_inserted = impl.builder->m_statsLastIteration.observationsInserted;
+  impl.inserted += was_inserted;
+  if (was_inserted) {
+    impl.inserted_scans.push_back(observation);
+    impl.inserted_path_index.push_back(impl.builder->mapPDF.m_particles.front().d->robotPath.size() - 1);
+  }
+  return was_inserted;
+}
+
+int RbpfMapper::scansAdded() const { return impl_->added; }
+int RbpfMapper::scansInserted() const { return impl_->inserted; }
+
+std::vector<RbpfParticle> RbpfMapper::particles() const {
+  std::vector<RbpfParticle> result;
+  if (!impl_->started) return result;
+  const auto estimate = impl_->builder->getCurrentPoseEstimation();
+  const auto* particles = dynamic_cast<const mrpt::poses::CPose3DPDFParticles*>(estimate.get());
+  if (particles == nullptr || particles->m_particles.empty()) return result;
+  double max_log = -std::numeric_limits<double>::infinity();
+  for (const auto& p : particles->m_particles) max_log = std::max(max_log, p.log_w);
+  double sum = 0.0;
+  for (const auto& p : particles->m_particles) {
+    result.push_back({fromMrpt(p.d), std::exp(p.log_w - max_log)});
+    sum += result.back().weight;
+  }
+  for (RbpfParticle& p : result) p.weight /= sum;
+  return result;
+}
+
+// The particle whose map getCurrentlyBuiltMetricMap() returns (MRPT picks the largest weight), so that the pose
+// and the map published with it come from the same particle.
+size_t RbpfMapper::Impl::mappedParticle() const {
+  const mrpt::maps::CMultiMetricMap* mapped = builder->getCurrentlyBuiltMetricMap();
+  const auto& all = builder->mapPDF.m_particles;
+  for (size_t i = 0; i < all.size(); ++i)
+    if (&all[i].d->mapTillNow == mapped) return i;
+  return 0;
+}
+
+Pose2 RbpfMapper::pose() const {
+  if (!impl_->started) return impl_->last_odometry;
+  const std::vector<RbpfParticle> all = particles();
+  if (all.empty()) return impl_->last_odometry;
+  const size_t mapped = impl_->mappedParticle();
+  return all[mapped < all.size() ? mapped : 0].pose;
+}
+
+Pose2 RbpfMapper::mapToOdom() const { return composePoses(pose(), invertPose(impl_->last_odometry)); }
+
+const mrpt::maps::COccupancyGridMap2D& RbpfMapper::Impl::publishedGrid() const {
+  const auto& path = builder->mapPDF.m_particles[mappedParticle()].d->robotPath;
+  size_t same = 0;  // leading scans already drawn at the same poses
+  while (same < rendered_poses.size() && same < inserted_scans.size() &&
+         path[inserted_path_index[same]] == rendered_poses[same])
+    ++same;
+  if (!rendered || same < rendered_poses.size()) {  // another path: draw all scans again
+    const auto filter_grid = builder->getCurrentlyBuiltMetricMap()->mapByClass<mrpt::maps::COccupancyGridMap2D>(0);
+    rendered.emplace(filter_grid->getXMin(), filter_grid->getXMax(), filter_grid->getYMin(), filter_grid->getYMax(),
+                     filter_grid->getResolution());
+    rendered->insertionOptions = published_insertion;
+    rendered_poses.clear();
+  }
+  for (size_t k = rendered_poses.size(); k < inserted_scans.size(); ++k) {
+    const mrpt::math::TPose3D& pose = path[inserted_path_index[k]];
+    rendered->insertObservation(*inserted_scans[k], mrpt::poses::CPose3D(pose));
+    rendered_poses.push_back(pose);
+  }
+  return *rendered;
+}
+
+OccupancyGrid RbpfMapper::map() const {
+  OccupancyGrid grid;
+  if (!impl_->started || impl_->inserted_scans.empty()) return grid;
+  const mrpt::maps::COccupancyGridMap2D& mrpt_grid = impl_->publishedGrid();
+  const int width = static_cast<int>(mrpt_grid.getSizeX()), height = static_cast<int>(mrpt_grid.getSizeY());
+  grid.resolution = shortest(mrpt_grid.getResolution());
+  grid.origin = Point2(shortest(mrpt_grid.getXMin()), shortest(mrpt_grid.getYMin()));
+  grid.cells.create(height, width);
+  for (int y = 0; y < height; ++y) {
+    const int row = height - 1 - y;  // MRPT's row 0 is the bottom
+    for (int x = 0; x < width; ++x) {
+      const float free_probability = mrpt_grid.getCell(x, y);  // 0.5 exactly: never observed
+      grid.cells(row, x) = free_probability == 0.5f
+                               ? OccupancyGrid::kUnknown
+                               : static_cast<int8_t>(std::lround(100.0 * (1.0 - free_probability)));
+    }
+  }
+  return grid;
+}
+
+}  // namespace hidden_rooms

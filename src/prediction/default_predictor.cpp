@@ -1,0 +1,769 @@
+#include "hidden_rooms/prediction/default_predictor.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <future>
+#include <limits>
+#include <map>
+
+#include <opencv2/imgproc.hpp>
+
+#include "hidden_rooms/common/input_error.h"
+#include "hidden_rooms/prediction/prediction_support.h"
+#include "hidden_rooms/prediction/thesis_predictor.h"
+
+namespace hidden_rooms {
+
+namespace {
+
+// Defaults (documented in config/prediction.yaml).
+constexpr double kStartSearchRadius = 1.0;   // m (shared with the baselines)
+constexpr double kWallGap = 1.5;             // m: longest gap in the door's wall still followed
+constexpr double kMaxExtent = 25.0;          // m: longest lateral extent and depth searched
+constexpr double kBoundedFraction = 0.5;     // share of columns ending on a known pixel for a measured depth
+constexpr double kNeighbourReach = 15.0;     // m: how far along the wall explored neighbours are looked for
+constexpr double kMinDepth = 2.0;            // m: smallest depth taken from the square prior
+constexpr double kMinRotation = 1.0;         // degrees: smaller dominant angles are not corrected
+constexpr double kGrownAreaRatio = 1.25;     // grown rooms less than this many times the rectangle give way
+constexpr double kStubLength = 0.3;          // m: wall stubs this long into the explored side end a room's extent
+constexpr double kOutlineReach = 15.0;       // m: band beside a room within which the known map's extent bounds it
+constexpr double kWallMargin = -1.0;         // m: unseen wall thickness left out of rooms; < 0: estimated from the map
+
+// Working states of a pixel; map values at or above kOccupiedFrom are walls.
+constexpr uint8_t kUnknownPx = 0, kFreePx = 1, kOccupiedPx = 2;
+constexpr int8_t kOccupiedFrom = 50;
+constexpr double kWallDrift = 0.15;  // m: how far past the door's first unknown row a tilted wall may reach
+
+cv::Mat1b statesOf(const OccupancyGrid& map) {
+  cv::Mat1b states(map.cells.size(), kUnknownPx);
+  states.setTo(kFreePx, map.cells >= 0);
+  states.setTo(kOccupiedPx, map.cells >= kOccupiedFrom);
+  return states;
+}
+
+struct Parameters {
+  double start_search_radius, wall_gap, max_extent, bounded_fraction, neighbour_reach, min_depth, min_rotation;
+  double grown_area_ratio, stub_length, outline_reach, wall_margin;
+};
+
+// A door in the working image: centre pixel, wall axis a and normal n (unit axis vectors, n into the unknown).
+struct DoorFrame {
+  bool ok = false;
+  std::string problem;
+  cv::Point p;
+  cv::Point a, n;
+  int half_width = 1;     // pixels
+  int band0 = 0, s0 = 0;  // wall rows v in [band0, s0), first unknown row s0
+  int left = 0, right = 0;  // lateral extent, u in [left, right]
+  bool lateral_open = false;
+  int depth = 0;           // pixels behind s0
+  bool bounded = false;
+  std::vector<int> bounded_depths;
+  double neighbour_depth = -1.0;
+  int depth_source = 0;  // 0 measured, 1 explored neighbours, 2 sibling doors, 3 square prior
+};
+
+class Frame {
+ public:
+  Frame(const cv::Mat1b& states, const cv::Rect& box) : s_(states), box_(box) {}
+  cv::Point at(const DoorFrame& d, int u, int v) const { return d.p + u * d.a + v * d.n; }
+  bool inside(const cv::Point& q) const { return q.x >= 0 && q.y >= 0 && q.x < s_.cols && q.y < s_.rows; }
+  bool inBox(const cv::Point& q) const { return box_.contains(q); }
+  uint8_t state(const cv::Point& q) const { return inside(q) ? s_(q) : kUnknownPx; }
+
+ private:
+  const cv::Mat1b& s_;
+  cv::Rect box_;
+};
+
+int median(std::vector<int> values) {
+  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+  return values[values.size() / 2];
+}
+
+// Unseen wall thickness in metres of the map whose statesOf is `states` (see unseenWallThickness in the header).
+double unseenWallMetres(const cv::Mat1b& states, double resolution) {
+  constexpr int kMinWallRun = 3;  // pixels: shorter runs between free pixels are specks and ragged wall faces
+  const int max_run = static_cast<int>(1.0 / resolution);  // walls are thinner than a metre
+  std::vector<int> through, one_sided;
+  const auto scan = [&](auto state_at, int lines, int length) {
+    for (int line = 0; line < lines; ++line) {
+      int begin = 0;
+      while (begin < length) {
+        if (state_at(line, begin) == kFreePx) {
+          ++begin;
+          continue;
+        }
+        int end = begin;  // the non-free run [begin, end)
+        while (end < length && state_at(line, end) != kFreePx) ++end;
+        const int run = end - begin;
+        const bool free_before = begin > 0, free_after = end < length;
+        if (free_before && free_after) {
+          if (run >= kMinWallRun && run <= max_run && state_at(line, begin) == kOccupiedPx &&
+              state_at(line, end - 1) == kOccupiedPx)
+            through.push_back(run);  // a wall seen from both sides (its inside may be unknown)
+        } else if (free_before || free_after) {
+          // A wall seen from the free side only: its occupied cells, followed by unknown ones.
+          int occupied = 0;
+          const int step = free_before ? 1 : -1, first = free_before ? begin : end - 1;
+          while (occupied < run && state_at(line, first + step * occupied) == kOccupiedPx) ++occupied;
+          if (occupied > 0 && occupied < run) one_sided.push_back(occupied);
+        }
+        begin = end;
+      }
+    }
+  };
+  scan([&](int r, int c) { return states(r, c); }, states.rows, states.cols);
+  scan([&](int c, int r) { return states(r, c); }, states.cols, states.rows);
+  if (through.size() < 20 || one_sided.size() < 20) return 0.0;
+  // The most common thickness: walls crossed at an angle give longer runs, which a median or quantile would follow.
+  std::map<int, int> counts;
+  for (int run : through) ++counts[run];
+  const int typical = std::max_element(counts.begin(), counts.end(), [](const auto& a, const auto& b) {
+                        return a.second < b.second;
+                      })->first;
+  return std::max(0, typical - median(one_sided)) * resolution;
+}
+
+// Unknown fraction of the strip behind the door (width of the door, `depth` pixels) on side n.
+double unknownBehind(const Frame& f, DoorFrame d, int depth) {
+  int unknown = 0, total = 0;
+  for (int v = 1; v <= depth; ++v)
+    for (int u = -d.half_width; u <= d.half_width; ++u) {
+      ++total;
+      unknown += f.state(f.at(d, u, v)) == kUnknownPx && f.inside(f.at(d, u, v));
+    }
+  return total ? static_cast<double>(unknown) / total : 0.0;
+}
+
+// Side, wall rows and first unknown row of a door.
+void placeDoor(const Frame& f, double resolution, const Parameters& P, DoorFrame* d) {
+  const int reach = std::max(2, static_cast<int>(std::lround(P.start_search_radius / resolution)));
+  const cv::Point n0 = d->n;
+  const double plus = unknownBehind(f, *d, reach);
+  d->n = -n0;
+  const double minus = unknownBehind(f, *d, reach);
+  d->n = plus >= minus ? n0 : -n0;
+  if (std::max(plus, minus) <= 0.0) {
+    d->problem = "no unknown space behind the door";
+    return;
+  }
+  // First row behind the door (v >= -reach/2) where most of the door's width is unknown.
+  d->s0 = std::numeric_limits<int>::min();
+  for (int v = -reach / 2; v <= reach; ++v) {
+    int unknown = 0, total = 0;
+    for (int u = -d->half_width; u <= d->half_width; ++u) {
+      const cv::Point q = f.at(*d, u, v);
+      if (!f.inside(q)) continue;
+      ++total;
+      unknown += f.state(q) == kUnknownPx;
+    }
+    if (total && unknown * 2 > total) {
+      // The row must be followed by unknown rows (not a speck inside the wall).
+      d->s0 = v;
+      break;
+    }
+  }
+  if (d->s0 == std::numeric_limits<int>::min()) {
+    d->problem = "no unknown space behind the door";
+    return;
+  }
+  // Wall rows: occupied rows just before s0 (any pixel across the door width).
+  d->band0 = d->s0;
+  for (int v = d->s0 - 1; v >= d->s0 - reach; --v) {
+    bool occupied = false;
+    for (int u = -d->half_width; u <= d->half_width && !occupied; ++u)
+      occupied = f.state(f.at(*d, u, v)) == kOccupiedPx;
+    if (!occupied) break;
+    d->band0 = v;
+  }
+  if (d->band0 == d->s0) d->band0 = d->s0 - 1;
+  d->ok = true;
+}
+
+// Occupied pixels in column u from row v towards the explored side (decreasing v), counted up to `limit`.
+int occupiedRun(const Frame& f, const DoorFrame& d, int u, int v, int limit) {
+  int run = 0;
+  while (run < limit && f.state(f.at(d, u, v - run)) == kOccupiedPx) ++run;
+  return run;
+}
+
+// Whether the wall goes on past a stub at a stepped row, as past the side wall of a door niche: beyond the stub
+// (column u_after onwards, `step` = +-1) row v_mid is not free and, within two columns, an occupied pixel lies
+// between rows v_from and v_to (the stub's length). A free-standing stub (a pillar, the end of a perpendicular
+// wall) has free space beyond it; a corner of the wall has nothing beyond it.
+bool isWallStep(const Frame& f, const DoorFrame& d, int u_after, int step, int v_from, int v_to, int v_mid) {
+  for (int k = 0; k < 3; ++k)
+    if (f.state(f.at(d, u_after + k * step, v_mid)) == kFreePx) return false;
+  for (int k = 0; k < 3; ++k)
+    for (int v = std::min(v_from, v_to); v <= std::max(v_from, v_to); ++v)
+      if (f.state(f.at(d, u_after + k * step, v)) == kOccupiedPx) return true;
+  return false;
+}
+
+// How far the room reaches along the wall in direction `sign`.
+int lateralExtent(const Frame& f, double resolution, const Parameters& P, DoorFrame* d, int sign) {
+  const int max_u = static_cast<int>(P.max_extent / resolution);
+  const int gap_limit = std::max(1, static_cast<int>(P.wall_gap / resolution));
+  const int probe1 = std::max(2, static_cast<int>(0.4 / resolution));
+  const int probe2 = std::max(3, static_cast<int>(0.8 / resolution));
+  int last_wall = 0, gap = 0;
+  // The wall is tracked: its rows may drift by a few pixels (slightly tilted walls of SLAM maps).
+  int band0 = d->band0, band1 = d->s0 - 1;
+  const int persistence = std::max(2, static_cast<int>(std::lround(0.15 / resolution)));
+  int known_run = 0;
+  const int stub_px = P.stub_length > 0.0 ? std::max(2, static_cast<int>(std::lround(P.stub_length / resolution))) : 0;
+  const int max_stub_width = std::max(2, static_cast<int>(1.0 / resolution));
+  for (int k = 1; k <= max_u; ++k) {
+    const int u = sign * k;
+    const cv::Point behind = f.at(*d, u, d->s0 + 1);
+    if (!f.inside(behind)) {
+      d->lateral_open = true;
+      return sign * std::max(k - 1, last_wall);
+    }
+    // Known space behind the wall over a few columns: a perpendicular wall of an explored room.
+    int known = 0;
+    for (int v : {band1 + 2, band1 + probe1, band1 + probe2}) known += f.state(f.at(*d, u, v)) != kUnknownPx;
+    if (known >= 2) {
+      if (++known_run >= persistence) return sign * (k - known_run);
+    } else {
+      known_run = 0;
+    }
+    // A stub of wall leaving the door's wall into the explored side (a pillar or the end of a perpendicular
+    // wall): rooms on the other side usually end there. The room ends at the stub's middle.
+    if (stub_px > 0 && k > d->half_width + 1 && occupiedRun(f, *d, u, band0 - 1, stub_px) >= stub_px) {
+      int width = 1;
+      while (width < max_stub_width && occupiedRun(f, *d, sign * (k + width), band0 - 1, stub_px) >= stub_px)
+        ++width;
+      // The side wall of a door niche (or of a step in the wall) is no stub: the wall goes on past it.
+      if (!isWallStep(f, *d, sign * (k + width), sign, band0 - 1, band0 - stub_px, band0 - 1 - stub_px / 2))
+        return sign * (k + (width - 1) / 2 - 1);  // up to the stub's middle column, exclusive
+    }
+    int first = std::numeric_limits<int>::max(), last = std::numeric_limits<int>::min();
+    for (int v = band0 - 2; v <= band1 + 2; ++v)
+      if (f.state(f.at(*d, u, v)) == kOccupiedPx) first = std::min(first, v), last = std::max(last, v);
+    if (last >= first) {
+      gap = 0;
+      last_wall = k;
+      band0 = first;
+      band1 = std::max(last, first);
+    } else if (++gap > gap_limit) {
+      return sign * last_wall;
+    }
+  }
+  return sign * max_u;
+}
+
+// Per column of the extent, the unknown run behind the wall; sets depth when enough columns end on known space.
+void measureDepth(const Frame& f, double resolution, const Parameters& P, DoorFrame* d) {
+  const int max_v = static_cast<int>(P.max_extent / resolution);
+  const int width = d->right - d->left + 1;
+  const int margin = width / 10;
+  d->bounded_depths.clear();
+  int columns = 0;
+  // A slightly tilted wall (SLAM maps) reaches a few rows past s0 away from the door: a column's run starts
+  // after its own wall pixels within that drift.
+  const int drift = std::max(1, static_cast<int>(std::lround(kWallDrift / resolution)));
+  for (int u = d->left + margin; u <= d->right - margin; ++u) {
+    ++columns;
+    int v = d->s0;
+    while (v < d->s0 + drift && f.inside(f.at(*d, u, v)) && f.state(f.at(*d, u, v)) != kUnknownPx) ++v;
+    for (; v <= d->s0 + max_v; ++v) {
+      const cv::Point q = f.at(*d, u, v);
+      if (!f.inside(q) || !f.inBox(q)) break;
+      if (f.state(q) != kUnknownPx) {
+        d->bounded_depths.push_back(v - d->s0);
+        break;
+      }
+    }
+  }
+  d->bounded = columns > 0 && d->bounded_depths.size() >= P.bounded_fraction * columns;
+  if (d->bounded) d->depth = median(d->bounded_depths);
+}
+
+// Depth of explored rooms on the same side of the same wall, within reach of the door's extent.
+double neighbourDepth(const Frame& f, double resolution, const Parameters& P, const DoorFrame& d) {
+  const int reach = static_cast<int>(P.neighbour_reach / resolution);
+  const int max_v = static_cast<int>(P.max_extent / resolution);
+  const int entry = std::max(2, static_cast<int>(0.5 / resolution));
+  const int unknown_run_limit = std::max(2, static_cast<int>(0.5 / resolution));
+  std::vector<int> depths;
+  for (int sign : {-1, 1}) {
+    const int start = sign < 0 ? d.left - 1 : d.right + 1;
+    for (int k = 0; k < reach; ++k) {
+      const int u = start + sign * k;
+      // An occupied pixel (the wall) then a free pixel just behind the wall line: an explored room there.
+      int v = d.band0 - 3;
+      while (v <= d.s0 + entry && f.state(f.at(d, u, v)) != kOccupiedPx) ++v;
+      while (v <= d.s0 + entry && f.state(f.at(d, u, v)) != kFreePx) ++v;
+      if (v > d.s0 + entry || v < d.s0 - 1) continue;
+      int unknown_run = 0;
+      bool closed = false;
+      for (; v <= d.s0 + max_v; ++v) {
+        const cv::Point q = f.at(d, u, v);
+        if (!f.inside(q)) break;
+        const uint8_t s = f.state(q);
+        if (s == kOccupiedPx) {
+          closed = true;
+          break;
+        }
+        unknown_run = s == kUnknownPx ? unknown_run + 1 : 0;
+        if (unknown_run > unknown_run_limit) break;
+      }
+      if (closed) depths.push_back(v - d.s0);
+    }
+  }
+  if (depths.size() < static_cast<size_t>(std::max(3, static_cast<int>(1.0 / resolution)))) return -1.0;
+  const int depth = median(depths);
+  return depth * resolution >= P.min_depth ? depth : -1.0;
+}
+
+// The image pixel of a door's position.
+cv::Point doorPixel(const OccupancyGrid& map, const MapDoor& door) {
+  const Point2 image = map.toImage(door.position);
+  return {static_cast<int>(std::floor(image.x())), static_cast<int>(std::floor(image.y()))};
+}
+
+// Pixels from a door's first unknown row `entry` to the near side of `box`, along the door's normal.
+int gapAlongNormal(const DoorFrame& d, const cv::Point& entry, const cv::Rect& box) {
+  if (d.n.x > 0) return box.x - entry.x;
+  if (d.n.x < 0) return entry.x - (box.br().x - 1);
+  if (d.n.y > 0) return box.y - entry.y;
+  return entry.y - (box.br().y - 1);
+}
+
+// The part of a room's rectangle before `box`, along the door's normal.
+cv::Rect endBefore(const DoorFrame& d, cv::Rect room, const cv::Rect& box) {
+  if (d.n.x > 0) room.width = std::max(0, box.x - room.x);
+  else if (d.n.x < 0) room.width = std::max(0, room.br().x - box.br().x), room.x = box.br().x;
+  else if (d.n.y > 0) room.height = std::max(0, box.y - room.y);
+  else room.height = std::max(0, room.br().y - box.br().y), room.y = box.br().y;
+  return room;
+}
+
+// Rotation of a point about the working transform.
+cv::Point2d applyAffine(const cv::Matx23d& m, const cv::Point2d& p) {
+  return {m(0, 0) * p.x + m(0, 1) * p.y + m(0, 2), m(1, 0) * p.x + m(1, 1) * p.y + m(1, 2)};
+}
+
+}  // namespace
+
+void clipToKnownOutline(const cv::Mat1b& known, const cv::Point& door, int reach, int min_depth, cv::Mat1b* mask) {
+  const cv::Rect image(0, 0, known.cols, known.rows);
+  const cv::Rect room = cv::boundingRect(*mask);
+  if (room.area() == 0) return;
+  // x limits from the rows beside the room, y limits from its columns.
+  const cv::Rect rows = cv::Rect(0, room.y - reach, known.cols, room.height + 2 * reach) & image;
+  const cv::Rect columns = cv::Rect(room.x - reach, 0, room.width + 2 * reach, known.rows) & image;
+  const cv::Rect in_rows = cv::boundingRect(known(rows)), in_columns = cv::boundingRect(known(columns));
+  if (in_rows.area() == 0 || in_columns.area() == 0) return;
+  const int x0 = in_rows.x, x1 = in_rows.br().x, y0 = in_columns.y + columns.y, y1 = in_columns.br().y + columns.y;
+  // Keep [x0, x1) x [y0, y1), each limit only when it lies at least min_depth beyond the door.
+  const cv::Rect keep(cv::Point(door.x - x0 >= min_depth ? x0 : 0, door.y - y0 >= min_depth ? y0 : 0),
+                      cv::Point(x1 - door.x >= min_depth ? x1 : known.cols, y1 - door.y >= min_depth ? y1 : known.rows));
+  cv::Mat1b outside(room.size(), 255);
+  outside((keep & room) - room.tl()).setTo(0);
+  (*mask)(room).setTo(0, outside);
+}
+
+double dominantWallAngle(const OccupancyGrid& map) {
+  // Only around the occupied cells (the blur and the gradients vanish 20 pixels away from them).
+  const cv::Mat1b occupied_cells = map.cells >= kOccupiedFrom;
+  const cv::Rect around = cv::boundingRect(occupied_cells);
+  if (around.area() == 0) return 0.0;
+  const cv::Rect crop = cv::Rect(around.x - 20, around.y - 20, around.width + 40, around.height + 40) &
+                        cv::Rect(0, 0, map.width(), map.height());
+  // Gradient directions, weighted by their magnitude, into a histogram modulo 90 degrees (walls run perpendicular
+  // to their gradients). The image is worked through in strips of rows, each with enough rows of context on both
+  // sides for the blur and the Sobel kernels, so that the working images stay small: the same values as on the
+  // whole image at once.
+  constexpr double kBlurSigma = 2.5;
+  constexpr int kSobelSize = 5;
+  constexpr int kStripRows = 64;
+  const int context = static_cast<int>(std::lround(4 * kBlurSigma)) + kSobelSize / 2 + 2;
+  constexpr int kBins = 180;  // half-degree bins over 90 degrees
+  std::vector<double> histogram(kBins, 0.0);
+  const cv::Mat1b cells = occupied_cells(crop);
+  cv::Mat1f occupied, gx, gy, magnitude, direction;  // direction in [0, 2 pi)
+  for (int top = 0; top < cells.rows; top += kStripRows) {
+    const int bottom = std::min(cells.rows, top + kStripRows);
+    const int first = std::max(0, top - context), last = std::min(cells.rows, bottom + context);
+    cells.rowRange(first, last).convertTo(occupied, CV_32F, 1.0 / 255.0);
+    cv::GaussianBlur(occupied, occupied, cv::Size(0, 0), kBlurSigma);
+    cv::Sobel(occupied, gx, CV_32F, 1, 0, kSobelSize);
+    cv::Sobel(occupied, gy, CV_32F, 0, 1, kSobelSize);
+    const cv::Range strip(top - first, bottom - first);
+    cv::cartToPolar(gx.rowRange(strip), gy.rowRange(strip), magnitude, direction);
+    for (int r = 0; r < magnitude.rows; ++r) {
+      const float* m = magnitude.ptr<float>(r);
+      const float* d = direction.ptr<float>(r);
+      for (int c = 0; c < magnitude.cols; ++c) {
+        if (m[c] < 1e-3f) continue;
+        const double angle = std::fmod(static_cast<double>(d[c]), CV_PI / 2.0);
+        const int bin = std::clamp(static_cast<int>(angle / (CV_PI / 2.0) * kBins), 0, kBins - 1);
+        histogram[bin] += m[c];
+      }
+    }
+  }
+  int best = 0;
+  double best_value = -1.0;
+  for (int b = 0; b < kBins; ++b) {
+    double value = 0.0;
+    for (int k = -3; k <= 3; ++k) value += histogram[(b + k + kBins) % kBins];
+    if (value > best_value) best_value = value, best = b;
+  }
+  if (best_value <= 0.0) return 0.0;
+  // Weighted mean around the peak (circular over the 90 degree period).
+  double sum = 0.0, weight = 0.0;
+  for (int k = -6; k <= 6; ++k) {
+    const double w = histogram[(best + k + kBins) % kBins];
+    sum += w * (best + k + 0.5);
+    weight += w;
+  }
+  double angle = (sum / weight) / kBins * (CV_PI / 2.0);
+  angle = std::fmod(angle + CV_PI, CV_PI / 2.0);
+  if (angle >= CV_PI / 4.0) angle -= CV_PI / 2.0;
+  return angle;
+}
+
+double unseenWallThickness(const OccupancyGrid& map) { return unseenWallMetres(statesOf(map), map.resolution); }
+
+std::map<std::string, double> DefaultPredictor::defaultParameters() const {
+  std::map<std::string, double> parameters = layoutParameters(LayoutOptions());  // for the grown rooms
+  parameters.insert({{"start_search_radius", kStartSearchRadius}, {"default_wall_gap", kWallGap},
+                     {"default_max_extent", kMaxExtent},          {"default_bounded_fraction", kBoundedFraction},
+                     {"default_neighbour_reach", kNeighbourReach}, {"default_min_depth", kMinDepth},
+                     {"default_min_rotation", kMinRotation},       {"default_grown_area_ratio", kGrownAreaRatio},
+                     {"default_stub_length", kStubLength},         {"default_outline_reach", kOutlineReach},
+                     {"default_wall_margin", kWallMargin}});
+  return parameters;
+}
+
+namespace {
+
+// The wall-fitted rectangle of every door (steps 1 to 3 of the header), in the map's frame; `angle` is the map's
+// dominantWallAngle, `map_states` its statesOf and `map_known` its known cells (255).
+std::vector<RoomPrediction> rectangleRooms(const PredictionRequest& request, const Parameters& P, double angle,
+                                           const cv::Mat1b& map_states, const cv::Mat1b& map_known) {
+  const OccupancyGrid& map = request.map;
+  const double resolution = map.resolution;
+
+  // 1. Orientation.
+  const bool rotate = std::abs(angle) * 180.0 / CV_PI >= P.min_rotation;
+  cv::Mat1b states = map_states;
+  cv::Matx23d forward(1, 0, 0, 0, 1, 0);
+  cv::Size work_size = states.size();
+  if (rotate) {
+    const double c = std::cos(-angle), s = std::sin(-angle);
+    const double w = states.cols, h = states.rows;
+    const int W = static_cast<int>(std::ceil(std::abs(c) * w + std::abs(s) * h)) + 2;
+    const int H = static_cast<int>(std::ceil(std::abs(s) * w + std::abs(c) * h)) + 2;
+    const cv::Point2d centre(w / 2.0, h / 2.0), new_centre(W / 2.0, H / 2.0);
+    forward = cv::Matx23d(c, -s, new_centre.x - (c * centre.x - s * centre.y), s, c,
+                          new_centre.y - (s * centre.x + c * centre.y));
+    work_size = cv::Size(W, H);
+    cv::Mat1b rotated;
+    cv::warpAffine(states, rotated, cv::Mat(forward), work_size, cv::INTER_NEAREST, cv::BORDER_CONSTANT,
+                   cv::Scalar(kUnknownPx));
+    states = rotated;
+  }
+  const Frame f(states, cv::boundingRect(states != kUnknownPx));
+
+  // 2. Doors.
+  const size_t count = request.doors.doors.size();
+  std::vector<DoorFrame> doors(count);
+  std::vector<std::string> problems(count);
+  for (size_t i = 0; i < count; ++i) {
+    const MapDoor& door = request.doors.doors[i];
+    DoorFrame& d = doors[i];
+    cv::Point unused;
+    if (!nearestUnknownCell(map, door.position, P.start_search_radius, &unused, &d.problem)) continue;
+    const Point2 image = map.toImage(door.position);
+    const cv::Point2d q = applyAffine(forward, cv::Point2d(image.x(), image.y()));
+    d.p = cv::Point(static_cast<int>(std::floor(q.x)), static_cast<int>(std::floor(q.y)));
+    d.a = door.orientation == DoorOrientation::kAlongX ? cv::Point(1, 0) : cv::Point(0, 1);
+    d.n = cv::Point(d.a.y, d.a.x);
+    d.half_width = std::max(1, static_cast<int>(0.5 * door.width / resolution));
+    placeDoor(f, resolution, P, &d);
+    if (!d.ok) continue;
+    d.left = lateralExtent(f, resolution, P, &d, -1);
+    d.right = lateralExtent(f, resolution, P, &d, +1);
+  }
+
+  // Doors on the same wall and side share its extent: cut at the midpoints.
+  auto along = [](const DoorFrame& d, const cv::Point& q) { return d.a.x * q.x + d.a.y * q.y; };
+  auto across = [](const DoorFrame& d, const cv::Point& q) { return d.n.x * q.x + d.n.y * q.y; };
+  const int same_wall = std::max(2, static_cast<int>(0.6 / resolution));
+  std::vector<std::vector<int>> siblings(count);
+  for (size_t i = 0; i < count; ++i) {
+    if (!doors[i].ok) continue;
+    DoorFrame& d = doors[i];
+    const int ci = along(d, d.p), wall_i = across(d, d.p) + d.s0;
+    int left = d.left, right = d.right;
+    for (size_t j = 0; j < count; ++j) {
+      if (j == i || !doors[j].ok) continue;
+      const DoorFrame& e = doors[j];
+      if (e.a != d.a || e.n != d.n) continue;
+      if (std::abs(across(e, e.p) + e.s0 - wall_i) > same_wall) continue;
+      const int offset = (along(e, e.p) - ci) * (d.a.x + d.a.y);  // u of the other door in d's frame
+      if (offset < d.left || offset > d.right) continue;
+      siblings[i].push_back(static_cast<int>(j));
+      if (offset > 0) right = std::min(right, offset / 2);
+      else if (offset < 0) left = std::max(left, offset / 2 + 1);
+    }
+    d.left = left;
+    d.right = right;
+  }
+  for (size_t i = 0; i < count; ++i)
+    if (doors[i].ok) measureDepth(f, resolution, P, &doors[i]);
+  for (size_t i = 0; i < count; ++i) {
+    DoorFrame& d = doors[i];
+    if (!d.ok || d.bounded) continue;
+    double depth = neighbourDepth(f, resolution, P, d);
+    d.depth_source = 1;
+    if (depth < 0) {
+      d.depth_source = 2;
+      std::vector<int> sibling_depths;
+      for (int j : siblings[i])
+        if (doors[j].bounded) sibling_depths.push_back(doors[j].depth);
+      if (!sibling_depths.empty()) depth = median(sibling_depths);
+    }
+    if (depth < 0) {
+      d.depth_source = 3;
+      depth = std::max(static_cast<double>(d.right - d.left + 1), P.min_depth / resolution);
+    }
+    d.depth = static_cast<int>(std::lround(depth));
+  }
+
+  // Rectangles (working image, [x0, x1] x [y0, y1] inclusive); overlapping rooms are cut apart by an
+  // axis-aligned line halfway between their doors, across the axis along which the doors lie farther apart.
+  std::vector<cv::Rect> rects(count);
+  for (size_t i = 0; i < count; ++i) {
+    const DoorFrame& d = doors[i];
+    if (!d.ok) continue;
+    const cv::Point c1 = f.at(d, d.left, d.s0), c2 = f.at(d, d.right, d.s0 + d.depth);
+    rects[i] = cv::Rect(cv::Point(std::min(c1.x, c2.x), std::min(c1.y, c2.y)),
+                        cv::Point(std::max(c1.x, c2.x) + 1, std::max(c1.y, c2.y) + 1));
+  }
+  const int min_depth_px = std::max(1, static_cast<int>(std::lround(P.min_depth / resolution)));
+  for (size_t i = 0; i < count; ++i)
+    for (size_t j = i + 1; j < count; ++j) {
+      if (!doors[i].ok || !doors[j].ok || (rects[i] & rects[j]).area() == 0) continue;
+      const cv::Point pi = f.at(doors[i], 0, doors[i].s0), pj = f.at(doors[j], 0, doors[j].s0);
+      auto cut = [](cv::Rect* r, int lo, int hi, bool x_axis) {  // keep [lo, hi) along the axis
+        int a = x_axis ? r->x : r->y, b = x_axis ? r->x + r->width : r->y + r->height;
+        a = std::max(a, lo), b = std::min(b, hi);
+        if (b < a) b = a;
+        if (x_axis) r->x = a, r->width = b - a;
+        else r->y = a, r->height = b - a;
+      };
+      auto split = [&](bool cut_x, cv::Rect* ri, cv::Rect* rj) {
+        const int ci = cut_x ? pi.x : pi.y, cj = cut_x ? pj.x : pj.y;
+        // The middle of the overlap, kept between the doors.
+        const int lo = std::max(cut_x ? ri->x : ri->y, cut_x ? rj->x : rj->y);
+        const int hi = std::min(cut_x ? ri->x + ri->width : ri->y + ri->height,
+                                cut_x ? rj->x + rj->width : rj->y + rj->height);
+        const int mid = std::clamp((lo + hi + 1) / 2, std::min(ci, cj) + 1, std::max(std::min(ci, cj) + 1, std::max(ci, cj)));
+        const int big = std::numeric_limits<int>::max() / 4;
+        cut(ri, ci < cj ? -big : mid, ci < cj ? mid : big, cut_x);
+        cut(rj, ci < cj ? mid : -big, ci < cj ? big : mid, cut_x);
+        return ci != cj;
+      };
+      // Doors on perpendicular walls: the overlap goes to the door nearer to it (along that door's normal); the
+      // other room ends where the overlap begins, when it keeps at least the smallest depth that way.
+      if ((doors[i].n.x != 0) != (doors[j].n.x != 0)) {
+        const cv::Rect overlap = rects[i] & rects[j];
+        const int gap_i = gapAlongNormal(doors[i], pi, overlap), gap_j = gapAlongNormal(doors[j], pj, overlap);
+        const size_t farther = gap_i > gap_j ? i : j;
+        const cv::Rect shortened = endBefore(doors[farther], rects[farther], overlap);
+        const int kept_depth = doors[farther].n.x != 0 ? shortened.width : shortened.height;
+        if (gap_i != gap_j && kept_depth >= min_depth_px) {
+          rects[farther] = shortened;
+          continue;
+        }
+      }
+      // Both cuts are tried; the one keeping more of the two rooms wins (doors in line: only the cut between).
+      cv::Rect xi = rects[i], xj = rects[j], yi = rects[i], yj = rects[j];
+      const bool x_ok = split(true, &xi, &xj), y_ok = split(false, &yi, &yj);
+      const bool use_x = x_ok && (!y_ok || xi.area() + xj.area() >= yi.area() + yj.area());
+      rects[i] = use_x ? xi : yi;
+      rects[j] = use_x ? xj : yj;
+    }
+
+  // 3. Masks in the working frame; overlaps left go to the nearest door.
+  std::vector<cv::Mat1b> masks(count);
+  cv::Mat1s owner(work_size, static_cast<short>(-1));
+  const cv::Mat1b unknown = states == kUnknownPx;
+  for (size_t i = 0; i < count; ++i) {
+    const DoorFrame& d = doors[i];
+    if (!d.ok) continue;
+    const cv::Rect rect = rects[i] & cv::Rect(0, 0, work_size.width, work_size.height);
+    masks[i] = cv::Mat1b::zeros(work_size);
+    if (rect.area() == 0) continue;
+    masks[i](rect).setTo(255, unknown(rect));
+    for (int r = rect.y; r < rect.br().y; ++r)
+      for (int c = rect.x; c < rect.br().x; ++c) {
+        if (!masks[i](r, c)) continue;
+        short& o = owner(r, c);
+        if (o < 0) {
+          o = static_cast<short>(i);
+          continue;
+        }
+        const cv::Point q(c, r);
+        const cv::Point po = doors[o].p, pi = d.p;
+        const double di = cv::norm(q - pi), dout = cv::norm(q - po);
+        if (di < dout) o = static_cast<short>(i);
+      }
+  }
+  for (size_t i = 0; i < count; ++i) {
+    if (!doors[i].ok || masks[i].empty()) continue;
+    // A room's pixels lie in its rectangle: the work below stays there.
+    const cv::Rect rect = rects[i] & cv::Rect(0, 0, work_size.width, work_size.height);
+    cv::Mat1b in_rect = masks[i](rect);
+    in_rect.setTo(0, owner(rect) != static_cast<short>(i));
+    // Keep what is connected to the door.
+    const cv::Point seed = f.at(doors[i], 0, doors[i].s0);
+    if (!rect.contains(seed) || !masks[i](seed)) {
+      // The door's own column may be claimed by another room: keep the largest part instead.
+      continue;
+    }
+    cv::Mat1b flood = cv::Mat1b::zeros(rect.height + 2, rect.width + 2);
+    cv::floodFill(in_rect, flood, seed - rect.tl(), 255, nullptr, 0, 0, 4 | cv::FLOODFILL_MASK_ONLY | (255 << 8));
+    flood(cv::Rect(1, 1, rect.width, rect.height)).copyTo(in_rect);
+  }
+
+  // Back to the map's frame.
+  std::vector<RoomPrediction> rooms;
+  for (size_t i = 0; i < count; ++i) {
+    RoomPrediction room;
+    room.door_id = request.doors.doors[i].id;
+    room.problem = doors[i].problem;
+    // Where the room's cells lie: its rectangle, or anywhere on a turned map.
+    cv::Rect cells_within(0, 0, map.width(), map.height());
+    if (doors[i].ok && !masks[i].empty()) {
+      if (rotate) {
+        cv::warpAffine(masks[i], room.mask, cv::Mat(forward), map.cells.size(),
+                       cv::INTER_NEAREST | cv::WARP_INVERSE_MAP, cv::BORDER_CONSTANT, cv::Scalar(0));
+      } else {
+        room.mask = masks[i];
+        cells_within &= rects[i];
+      }
+      room.mask(cells_within).setTo(0, map_known(cells_within));
+      room.terms["width"] = (doors[i].right - doors[i].left + 1) * resolution;
+      room.terms["depth"] = doors[i].depth * resolution;
+      room.terms["depth_bounded"] = doors[i].bounded ? 1.0 : 0.0;
+      room.terms["depth_source"] = doors[i].depth_source;
+      room.terms["lateral_open"] = doors[i].lateral_open ? 1.0 : 0.0;
+      room.terms["rotation"] = angle * 180.0 / CV_PI;
+    } else {
+      room.mask = cv::Mat1b::zeros(map.cells.size());
+    }
+    finishPrediction(map, &room, cells_within);
+    rooms.push_back(std::move(room));
+  }
+  return rooms;
+}
+
+}  // namespace
+
+PredictionResult DefaultPredictor::predict(const PredictionRequest& request) const {
+  const auto start_time = std::chrono::steady_clock::now();
+  checkUsableMap(request.map);
+  const auto values = resolveParameters(*this, request.parameters);
+  const Parameters P{values.at("start_search_radius"),     values.at("default_wall_gap"),
+                     values.at("default_max_extent"),      values.at("default_bounded_fraction"),
+                     values.at("default_neighbour_reach"), values.at("default_min_depth"),
+                     values.at("default_min_rotation"),    values.at("default_grown_area_ratio"),
+                     values.at("default_stub_length"),     values.at("default_outline_reach"),
+                     values.at("default_wall_margin")};
+  if (P.start_search_radius <= 0.0 || P.wall_gap < 0.0 || P.max_extent <= 0.0 || P.neighbour_reach < 0.0 ||
+      P.min_depth < 0.0 || P.min_rotation < 0.0 || P.bounded_fraction < 0.0 || P.bounded_fraction > 1.0 ||
+      P.grown_area_ratio < 0.0 || P.stub_length < 0.0 || P.outline_reach < 0.0 || std::isnan(P.wall_margin))
+    throw InputError("parameters", "default_* parameters out of range");
+
+  // The grown rooms: the thesis's growth with its own constants on the layout this request configures. It does
+  // not depend on the rectangles, so it runs on a second thread meanwhile.
+  PredictionRequest grown_request;
+  grown_request.map = request.map;
+  grown_request.doors = request.doors;
+  grown_request.debug_dir = request.debug_dir;
+  for (const std::string& name : layoutParameterNames()) grown_request.parameters[name] = values.at(name);
+  std::future<PredictionResult> growth =
+      std::async(std::launch::async, [&grown_request] { return ThesisPredictor().predict(grown_request); });
+
+  const double angle = dominantWallAngle(request.map);
+  const cv::Mat1b states = statesOf(request.map);
+  const cv::Mat1b known = request.map.cells != OccupancyGrid::kUnknown;
+  std::vector<RoomPrediction> rectangles = rectangleRooms(request, P, angle, states, known);
+  const double resolution = request.map.resolution;
+  // Cells within the wall margin of an occupied cell: the unseen rest of the walls the robot saw from one side.
+  const double wall_margin = P.wall_margin >= 0.0 ? P.wall_margin : unseenWallMetres(states, resolution);
+
+  // The layout's cells are axis-aligned: on a turned map only the rectangles (built on the map turned straight),
+  // and the growth's result (or error) is dropped.
+  const bool turned = std::abs(angle) * 180.0 / CV_PI >= P.min_rotation;
+  std::vector<RoomPrediction> grown(rectangles.size());
+  if (turned) growth.wait();
+  else grown = growth.get().rooms;
+
+  // Per door: the grown room, unless it is much smaller than the rectangle (it stopped short of the walls the
+  // rectangle found) or missing; a rectangle gives up the pixels of the grown rooms kept for other doors.
+  const size_t count = rectangles.size();
+  std::vector<bool> use_rectangle(count, false);
+  std::vector<cv::Rect> boxes(count);  // bounding box of each chosen room: every later step only removes cells
+  cv::Mat1b kept_grown = cv::Mat1b::zeros(request.map.cells.size());
+  for (size_t i = 0; i < count; ++i) {
+    use_rectangle[i] = turned || (rectangles[i].placed && grown[i].area < P.grown_area_ratio * rectangles[i].area);
+    const RoomPrediction& room = use_rectangle[i] ? rectangles[i] : grown[i];
+    if (room.placed) boxes[i] = cv::boundingRect(room.mask);
+    if (!use_rectangle[i] && grown[i].placed) kept_grown(boxes[i]) |= grown[i].mask(boxes[i]);
+  }
+  cv::Mat1b wall_band;
+  if (wall_margin > 0.0) {
+    // Computed around the rooms only, with a margin beyond them so that their cells get their true distances.
+    cv::Rect rooms_box;
+    for (const cv::Rect& box : boxes) rooms_box |= box;
+    const int reach = static_cast<int>(std::ceil(wall_margin / resolution)) + 2;
+    const cv::Rect box = cv::Rect(rooms_box.x - reach, rooms_box.y - reach, rooms_box.width + 2 * reach,
+                                  rooms_box.height + 2 * reach) &
+                         cv::Rect(0, 0, request.map.width(), request.map.height());
+    wall_band = cv::Mat1b::zeros(request.map.cells.size());
+    if (rooms_box.area() > 0 && box.area() > 0) {
+      cv::Mat1f distance;
+      cv::distanceTransform(request.map.cells(box) < kOccupiedFrom, distance, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+      wall_band(box).setTo(255, distance * resolution <= wall_margin);
+    }
+  }
+  PredictionResult result;
+  for (size_t i = 0; i < count; ++i) {
+    RoomPrediction room = std::move(use_rectangle[i] ? rectangles[i] : grown[i]);
+    const cv::Rect& box = boxes[i];
+    const auto cells = [&] { return cv::countNonZero(room.mask(box)); };
+    if (use_rectangle[i]) {
+      room.mask(box).setTo(0, kept_grown(box));
+      finishPrediction(request.map, &room, box);
+    }
+    if (!turned && P.outline_reach > 0.0 && room.placed) {
+      const int before = cells();
+      clipToKnownOutline(known, doorPixel(request.map, request.doors.doors[i]),
+                         static_cast<int>(std::lround(P.outline_reach / resolution)),
+                         static_cast<int>(std::lround(P.min_depth / resolution)), &room.mask);
+      room.terms["outline_clipped"] = (before - cells()) * resolution * resolution;
+      finishPrediction(request.map, &room, box);
+    }
+    if (!wall_band.empty() && room.placed) {
+      const int before = cells();
+      room.mask(box).setTo(0, wall_band(box));
+      room.terms["wall_margin"] = wall_margin;
+      room.terms["wall_margin_cut"] = (before - cells()) * resolution * resolution;
+      finishPrediction(request.map, &room, box);
+    }
+    room.terms["rectangle"] = use_rectangle[i] ? 1.0 : 0.0;
+    result.rooms.push_back(std::move(room));
+  }
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
+  return result;
+}
+
+}  // namespace hidden_rooms

@@ -1,0 +1,900 @@
+#include "hidden_rooms/prediction/layout.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <sstream>
+
+#include <opencv2/imgproc.hpp>
+
+#include "hidden_rooms/common/image_io.h"
+#include "hidden_rooms/common/input_error.h"
+#include "hidden_rooms/common/parameter_table.h"
+
+namespace hidden_rooms {
+
+// ---------------------------------------------------------------------------------------------------------
+// Options
+
+namespace {
+
+using ParameterField = hidden_rooms::ParameterField<LayoutOptions>;
+
+// config/layout.yaml's order.
+const std::vector<ParameterField>& parameterFields() {
+  static const std::vector<ParameterField> fields{
+      {"binary_threshold", &LayoutOptions::binary_threshold},
+      {"canny_low_threshold", &LayoutOptions::canny_low_threshold},
+      {"canny_high_threshold", &LayoutOptions::canny_high_threshold},
+      {"canny_aperture", &LayoutOptions::canny_aperture},
+      {"hough_rho", &LayoutOptions::hough_rho},
+      {"hough_theta", &LayoutOptions::hough_theta},
+      {"hough_threshold", &LayoutOptions::hough_threshold},
+      {"hough_min_line_length", &LayoutOptions::hough_min_line_length},
+      {"hough_max_line_gap", &LayoutOptions::hough_max_line_gap},
+      {"angular_bandwidth", &LayoutOptions::angular_bandwidth},
+      {"wall_cluster_distance", &LayoutOptions::wall_cluster_distance},
+      {"line_merge_distance", &LayoutOptions::line_merge_distance},
+      {"door_pair_lines", &LayoutOptions::door_pair_lines},
+      {"boundary_offset", &LayoutOptions::boundary_offset},
+      {"out_unknown_fraction", &LayoutOptions::out_unknown_fraction},
+      {"wall_coverage_band", &LayoutOptions::wall_coverage_band},
+      {"affinity_sigma", &LayoutOptions::affinity_sigma},
+      {"dbscan_eps", &LayoutOptions::dbscan_eps},
+      {"dbscan_min_points", &LayoutOptions::dbscan_min_points},
+      {"door_search_radius", &LayoutOptions::door_search_radius},
+  };
+  return fields;
+}
+
+}  // namespace
+
+const std::vector<std::string>& layoutParameterNames() {
+  static const std::vector<std::string> names = parameterNames(parameterFields());
+  return names;
+}
+
+std::map<std::string, double> layoutParameters(const LayoutOptions& options) {
+  return parameterValues(parameterFields(), options);
+}
+
+void applyLayoutParameters(const std::map<std::string, double>& parameters, LayoutOptions* options) {
+  applyParameterValues(parameterFields(), parameters, options);
+  validateLayoutOptions(*options);
+}
+
+LayoutOptions layoutOptionsFromParameters(const std::map<std::string, double>& parameters) {
+  const std::vector<std::string>& names = layoutParameterNames();
+  for (const auto& entry : parameters)
+    if (std::find(names.begin(), names.end(), entry.first) == names.end())
+      throw InputError("parameters", "unknown parameter '" + entry.first + "'");
+  LayoutOptions options;
+  applyLayoutParameters(parameters, &options);
+  return options;
+}
+
+void validateLayoutOptions(const LayoutOptions& o) {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  requireFiniteParameters(parameterFields(), o);
+  requireParameterInRange("binary_threshold", o.binary_threshold, {0, 255, false, false});
+  requireParameterInRange("canny_low_threshold", o.canny_low_threshold, {0, kInf, false, true});
+  requireParameterInRange("canny_high_threshold", o.canny_high_threshold, {0, kInf, false, true});
+  if (o.canny_aperture != 3 && o.canny_aperture != 5 && o.canny_aperture != 7)
+    throw InputError("parameters",
+                     "parameter 'canny_aperture' must be 3, 5 or 7, got " + formatNumber(o.canny_aperture));
+  requireParameterInRange("hough_rho", o.hough_rho, {0, kInf, true, true});
+  requireParameterInRange("hough_theta", o.hough_theta, {0, CV_PI, true, true});
+  requireParameterInRange("hough_threshold", o.hough_threshold, {0, kInf, true, true});
+  requireParameterInRange("hough_min_line_length", o.hough_min_line_length, {0, kInf, false, true});
+  requireParameterInRange("hough_max_line_gap", o.hough_max_line_gap, {0, kInf, false, true});
+  requireParameterInRange("angular_bandwidth", o.angular_bandwidth, {0, CV_PI / 2, true, true});
+  requireParameterInRange("wall_cluster_distance", o.wall_cluster_distance, {0, kInf, false, true});
+  requireParameterInRange("line_merge_distance", o.line_merge_distance, {0, kInf, false, true});
+  if (o.door_pair_lines != 0 && o.door_pair_lines != 1)
+    throw InputError("parameters",
+                     "parameter 'door_pair_lines' must be 0 or 1, got " + formatNumber(o.door_pair_lines));
+  requireParameterInRange("boundary_offset", o.boundary_offset, {0, kInf, true, true});
+  requireParameterInRange("out_unknown_fraction", o.out_unknown_fraction, {0, 1, false, false});
+  requireParameterInRange("wall_coverage_band", o.wall_coverage_band, {0, kInf, false, true});
+  requireParameterInRange("affinity_sigma", o.affinity_sigma, {0, kInf, true, true});
+  requireParameterInRange("dbscan_eps", o.dbscan_eps, {0, 1, true, true});
+  requireParameterInRange("dbscan_min_points", o.dbscan_min_points, {1, kInf, false, true, true});
+  requireParameterInRange("door_search_radius", o.door_search_radius, {0, kInf, true, true});
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Geometry helpers
+
+double ImageSegment::angle() const {
+  double angle = std::atan2(b.y() - a.y(), b.x() - a.x());
+  if (angle < 0) angle += CV_PI;
+  if (angle >= CV_PI) angle -= CV_PI;
+  return angle;
+}
+
+std::vector<int> CellGrid::edgeNeighbours(int cell) const {
+  std::vector<int> neighbours;
+  const int i = column(cell), j = row(cell);
+  if (i > 0) neighbours.push_back(index(i - 1, j));
+  if (i + 1 < columns()) neighbours.push_back(index(i + 1, j));
+  if (j > 0) neighbours.push_back(index(i, j - 1));
+  if (j + 1 < rows()) neighbours.push_back(index(i, j + 1));
+  return neighbours;
+}
+
+std::vector<int> CellGrid::vertexNeighbours(int cell) const {
+  std::vector<int> neighbours;
+  const int i = column(cell), j = row(cell);
+  for (int dj = -1; dj <= 1; ++dj)
+    for (int di = -1; di <= 1; ++di) {
+      if (di == 0 && dj == 0) continue;
+      const int ni = i + di, nj = j + dj;
+      if (ni >= 0 && ni < columns() && nj >= 0 && nj < rows()) neighbours.push_back(index(ni, nj));
+    }
+  return neighbours;
+}
+
+double CellGrid::wallFraction(int a, int b) const {
+  if (a > b) std::swap(a, b);
+  const int ia = column(a), ja = row(a), ib = column(b), jb = row(b);
+  if (ja == jb && ib == ia + 1) return right_wall[a];
+  if (ia == ib && jb == ja + 1) return below_wall[a];
+  return -1.0;
+}
+
+bool CellGrid::sharedEdge(int a, int b, ImageSegment* edge) const {
+  if (a > b) std::swap(a, b);
+  const int ia = column(a), ja = row(a), ib = column(b), jb = row(b);
+  if (ja == jb && ib == ia + 1) {
+    edge->a = Point2(xs[ib], ys[ja]);
+    edge->b = Point2(xs[ib], ys[ja + 1]);
+    return true;
+  }
+  if (ia == ib && jb == ja + 1) {
+    edge->a = Point2(xs[ia], ys[jb]);
+    edge->b = Point2(xs[ia + 1], ys[jb]);
+    return true;
+  }
+  return false;
+}
+
+int CellGrid::cellAt(const Point2& p) const {
+  if (columns() == 0 || rows() == 0) return -1;
+  if (p.x() < xs.front() || p.x() >= xs.back() || p.y() < ys.front() || p.y() >= ys.back()) return -1;
+  const int i = static_cast<int>(std::upper_bound(xs.begin(), xs.end(), p.x()) - xs.begin()) - 1;
+  const int j = static_cast<int>(std::upper_bound(ys.begin(), ys.end(), p.y()) - ys.begin()) - 1;
+  return index(i, j);
+}
+
+cv::Mat1b cellsMask(const Layout& layout, const std::vector<int>& cells) {
+  cv::Mat1b mask = cv::Mat1b::zeros(layout.image_size);
+  const cv::Rect image(cv::Point(0, 0), layout.image_size);
+  for (int cell : cells) {
+    const cv::Rect inside = layout.grid.cells.at(cell).rect & image;
+    if (inside.area() > 0) mask(inside).setTo(255);
+  }
+  return mask;
+}
+
+namespace {
+
+int toPixels(double metres, double resolution, int minimum) {
+  return std::max(minimum, static_cast<int>(std::lround(metres / resolution)));
+}
+
+// A distance threshold in pixels, a hair larger so that e.g. 0.15 m at 0.05 m keeps 3 px despite rounding.
+double toPixelDistance(double metres, double resolution) { return metres / resolution * (1.0 + 1e-9); }
+
+// Difference of two angles modulo pi, in [-pi/2, pi/2).
+double angleDifference(double a, double b) {
+  double d = std::fmod(a - b, CV_PI);
+  if (d < -CV_PI / 2) d += CV_PI;
+  if (d >= CV_PI / 2) d -= CV_PI;
+  return d;
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Angular clustering: 1-D mean shift with a flat kernel on the segments' angles modulo pi, each segment
+// weighted by its length. Every segment's angle seeds a search; modes closer than the bandwidth merge; each
+// segment joins its nearest mode, which finally becomes the weighted mean angle of its members.
+
+void clusterAngles(double bandwidth, Layout* layout) {
+  const std::vector<ImageSegment>& segments = layout->segments;
+  const int n = static_cast<int>(segments.size());
+  layout->angular_modes.clear();
+  layout->segment_angular_cluster.assign(n, -1);
+  if (n == 0) return;
+
+  // Angles sorted, repeated at -pi and +pi so that a window never needs wrapping; prefix sums of weights and
+  // weighted angles give every window's mean in O(log n).
+  std::vector<std::pair<double, double>> sorted;  // (angle, weight)
+  for (const ImageSegment& s : segments) sorted.emplace_back(s.angle(), std::max(s.length(), 1e-6));
+  std::sort(sorted.begin(), sorted.end());
+  std::vector<double> angles, weight_sum(1, 0.0), moment_sum(1, 0.0);
+  for (double shift : {-CV_PI, 0.0, CV_PI})
+    for (const auto& [angle, weight] : sorted) {
+      angles.push_back(angle + shift);
+      weight_sum.push_back(weight_sum.back() + weight);
+      moment_sum.push_back(moment_sum.back() + weight * (angle + shift));
+    }
+
+  auto shiftToMode = [&](double mode) {
+    for (int iteration = 0; iteration < 100; ++iteration) {
+      const size_t lo = std::lower_bound(angles.begin(), angles.end(), mode - bandwidth) - angles.begin();
+      const size_t hi = std::upper_bound(angles.begin(), angles.end(), mode + bandwidth) - angles.begin();
+      const double weight = weight_sum[hi] - weight_sum[lo];
+      if (weight <= 0) break;
+      const double next = (moment_sum[hi] - moment_sum[lo]) / weight;
+      const bool converged = std::abs(next - mode) < 1e-7;
+      mode = angleModuloPi(next);
+      if (converged) break;
+    }
+    return mode;
+  };
+
+  std::vector<double> modes;
+  double previous_seed = std::numeric_limits<double>::quiet_NaN();
+  for (const auto& [angle, weight] : sorted) {
+    if (std::abs(angle - previous_seed) < 1e-9) continue;  // same seed, same mode
+    previous_seed = angle;
+    modes.push_back(shiftToMode(angle));
+  }
+
+  // Merge modes within the bandwidth (sorted sweep, then the wrap-around pair).
+  std::sort(modes.begin(), modes.end());
+  std::vector<std::vector<double>> groups;
+  for (double mode : modes) {
+    if (!groups.empty() && std::abs(angleDifference(mode, groups.back().front())) <= bandwidth)
+      groups.back().push_back(mode);
+    else
+      groups.push_back({mode});
+  }
+  if (groups.size() > 1 && std::abs(angleDifference(groups.front().front(), groups.back().front())) <= bandwidth) {
+    groups.front().insert(groups.front().end(), groups.back().begin(), groups.back().end());
+    groups.pop_back();
+  }
+  std::vector<double> merged;
+  for (const auto& group : groups) {
+    double offset = 0;
+    for (double mode : group) offset += angleDifference(mode, group.front());
+    merged.push_back(angleModuloPi(group.front() + offset / group.size()));
+  }
+
+  // Assign, then recentre each mode on its members.
+  std::vector<double> offset_sum(merged.size(), 0.0), member_weight(merged.size(), 0.0);
+  for (int s = 0; s < n; ++s) {
+    const double angle = segments[s].angle();
+    int best = 0;
+    for (size_t m = 1; m < merged.size(); ++m)
+      if (std::abs(angleDifference(angle, merged[m])) < std::abs(angleDifference(angle, merged[best]))) best = m;
+    layout->segment_angular_cluster[s] = best;
+    offset_sum[best] += segments[s].length() * angleDifference(angle, merged[best]);
+    member_weight[best] += segments[s].length();
+  }
+  // Drop empty modes (renumbering the rest).
+  std::vector<int> renumber(merged.size(), -1);
+  for (size_t m = 0; m < merged.size(); ++m) {
+    if (member_weight[m] <= 0) continue;
+    renumber[m] = static_cast<int>(layout->angular_modes.size());
+    layout->angular_modes.push_back(angleModuloPi(merged[m] + offset_sum[m] / member_weight[m]));
+  }
+  for (int& cluster : layout->segment_angular_cluster) cluster = renumber[cluster];
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Spatial clustering inside each angular cluster: segments sorted by their lateral offset (distance of their
+// midpoint from a line through the origin along the cluster's angle); a wall takes segments while their offset
+// stays within `max_spread` pixels of the wall's first (smallest) offset, so that one wall never spans more
+// than `max_spread` across (a chain of close segments cannot grow into a thick band).
+
+void clusterWalls(double max_spread, Layout* layout) {
+  layout->walls.clear();
+  for (int cluster = 0; cluster < static_cast<int>(layout->angular_modes.size()); ++cluster) {
+    const double mode = layout->angular_modes[cluster];
+    const Point2 along(std::cos(mode), std::sin(mode));
+    const Point2 across(-along.y(), along.x());
+    std::vector<std::pair<double, int>> offsets;  // (offset, segment)
+    for (int s = 0; s < static_cast<int>(layout->segments.size()); ++s) {
+      if (layout->segment_angular_cluster[s] != cluster) continue;
+      const ImageSegment& segment = layout->segments[s];
+      offsets.emplace_back(across.dot(0.5 * (segment.a + segment.b)), s);
+    }
+    std::sort(offsets.begin(), offsets.end());
+    for (size_t first = 0; first < offsets.size();) {
+      size_t end = first;
+      while (end < offsets.size() && offsets[end].first - offsets[first].first <= max_spread) ++end;
+      Wall wall;
+      wall.angular_cluster = cluster;
+      double weighted_offset = 0, total_length = 0;
+      double t_min = std::numeric_limits<double>::infinity(), t_max = -t_min;
+      for (size_t k = first; k < end; ++k) {
+        const ImageSegment& segment = layout->segments[offsets[k].second];
+        wall.segments.push_back(offsets[k].second);
+        weighted_offset += segment.length() * offsets[k].first;
+        total_length += segment.length();
+        for (const Point2& p : {segment.a, segment.b}) {
+          t_min = std::min(t_min, along.dot(p));
+          t_max = std::max(t_max, along.dot(p));
+        }
+      }
+      const double offset = weighted_offset / total_length;
+      wall.segment.a = offset * across + t_min * along;
+      wall.segment.b = offset * across + t_max * along;
+      layout->walls.push_back(std::move(wall));
+      first = end;
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Extended lines
+
+// Lines of one axis closer than `merge_distance` become one. A group holding a boundary line keeps it; else
+// a group with wall lines keeps their mean position and its longest wall; else (door pair lines only) the mean.
+std::vector<ExtendedLine> mergeLines(std::vector<ExtendedLine> lines, double merge_distance, const Layout& layout) {
+  std::sort(lines.begin(), lines.end(), [](const ExtendedLine& a, const ExtendedLine& b) {
+    return a.position < b.position;
+  });
+  std::vector<ExtendedLine> merged;
+  for (size_t first = 0; first < lines.size();) {
+    size_t end = first + 1;
+    while (end < lines.size() && (lines[end].position - lines[first].position <= merge_distance ||
+                                  lines[end].position == lines[first].position))
+      ++end;
+    ExtendedLine result = lines[first];
+    const auto has = [&](LineSource source) {
+      return std::any_of(lines.begin() + first, lines.begin() + end,
+                         [&](const ExtendedLine& line) { return line.source == source; });
+    };
+    const LineSource kept = has(LineSource::kBoundary) ? LineSource::kBoundary
+                            : has(LineSource::kWall)   ? LineSource::kWall
+                                                       : LineSource::kDoorPair;
+    double position_sum = 0, longest = -1;
+    int count = 0;
+    for (size_t k = first; k < end; ++k) {
+      if (lines[k].source != kept) continue;
+      if (kept == LineSource::kBoundary) {
+        result = lines[k];
+        break;
+      }
+      position_sum += lines[k].position;
+      ++count;
+      if (kept == LineSource::kWall && layout.walls[lines[k].wall].segment.length() > longest) {
+        longest = layout.walls[lines[k].wall].segment.length();
+        result.wall = lines[k].wall;
+      }
+    }
+    if (kept != LineSource::kBoundary) {
+      result.source = kept;
+      result.position = static_cast<int>(std::lround(position_sum / count));
+      if (kept == LineSource::kDoorPair) result.wall = -1;
+    }
+    merged.push_back(result);
+    first = end;
+  }
+  return merged;
+}
+
+// One line per wall, snapped to the nearer axis through the wall's midpoint, then merged.
+std::vector<ExtendedLine> wallLines(const Layout& layout, double merge_distance) {
+  std::vector<ExtendedLine> horizontal, vertical;
+  for (int w = 0; w < static_cast<int>(layout.walls.size()); ++w) {
+    const ImageSegment& segment = layout.walls[w].segment;
+    const Point2 middle = 0.5 * (segment.a + segment.b);
+    const Point2 direction = segment.b - segment.a;
+    ExtendedLine line;
+    line.source = LineSource::kWall;
+    line.wall = w;
+    if (std::abs(direction.x()) >= std::abs(direction.y())) {
+      line.axis = LineAxis::kHorizontal;
+      line.position = static_cast<int>(std::lround(middle.y()));
+      horizontal.push_back(line);
+    } else {
+      line.axis = LineAxis::kVertical;
+      line.position = static_cast<int>(std::lround(middle.x()));
+      vertical.push_back(line);
+    }
+  }
+  std::vector<ExtendedLine> lines = mergeLines(horizontal, merge_distance, layout);
+  const std::vector<ExtendedLine> merged_vertical = mergeLines(vertical, merge_distance, layout);
+  lines.insert(lines.end(), merged_vertical.begin(), merged_vertical.end());
+  return lines;
+}
+
+// Algorithm 1 (METHOD.md §3.3), read for its intent: every pair of closed doors must be separated by a line.
+// Doors farther apart in y than in x need a horizontal line (constant y) strictly between their y; otherwise a
+// vertical line strictly between their x. When no line of that axis lies strictly between them, one is added
+// through their midpoint (unless a line already lies within the merge distance of it). Lines added for earlier
+// pairs count for later pairs. Only lines strictly inside the boundary are added.
+void addDoorPairLines(const std::vector<Point2>& doors, const cv::Rect& boundary, double merge_distance,
+                      std::vector<ExtendedLine>* lines) {
+  for (size_t i = 0; i < doors.size(); ++i)
+    for (size_t e = i + 1; e < doors.size(); ++e) {
+      const Point2& a = doors[i];
+      const Point2& b = doors[e];
+      const bool horizontal = std::abs(a.x() - b.x()) < std::abs(a.y() - b.y());
+      const LineAxis axis = horizontal ? LineAxis::kHorizontal : LineAxis::kVertical;
+      const double low = horizontal ? std::min(a.y(), b.y()) : std::min(a.x(), b.x());
+      const double high = horizontal ? std::max(a.y(), b.y()) : std::max(a.x(), b.x());
+      const double middle = 0.5 * (low + high);
+      const int position = static_cast<int>(std::lround(middle));
+      bool separated = false, crowded = false;
+      for (const ExtendedLine& line : *lines) {
+        if (line.axis != axis) continue;
+        separated |= line.position > low && line.position < high;
+        crowded |= std::abs(line.position - middle) <= merge_distance;
+      }
+      if (separated || crowded || position <= low || position >= high) continue;
+      const int lo_bound = horizontal ? boundary.y : boundary.x;
+      const int hi_bound = horizontal ? boundary.br().y : boundary.br().x;
+      if (position <= lo_bound || position >= hi_bound) continue;
+      ExtendedLine line;
+      line.axis = axis;
+      line.position = position;
+      line.source = LineSource::kDoorPair;
+      lines->push_back(line);
+    }
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Cells
+
+// Per pixel position along the line, whether an occupied pixel lies within `band` pixels across it; returned as
+// prefix sums over the image range (index 0..length).
+std::vector<int> coveragePrefix(const cv::Mat1b& occupied, LineAxis axis, int position, int band) {
+  const int length = axis == LineAxis::kHorizontal ? occupied.cols : occupied.rows;
+  std::vector<uint8_t> covered(length, 0);
+  if (axis == LineAxis::kHorizontal) {
+    for (int r = std::max(0, position - band); r < std::min(occupied.rows, position + band); ++r) {
+      const uint8_t* row = occupied.ptr<uint8_t>(r);
+      for (int c = 0; c < length; ++c) covered[c] |= row[c];
+    }
+  } else {
+    const int c0 = std::max(0, position - band), c1 = std::min(occupied.cols, position + band);
+    for (int r = 0; r < length && c0 < c1; ++r) {
+      const uint8_t* row = occupied.ptr<uint8_t>(r);
+      covered[r] = std::any_of(row + c0, row + c1, [](uint8_t v) { return v != 0; });
+    }
+  }
+  std::vector<int> prefix(length + 1, 0);
+  for (int k = 0; k < length; ++k) prefix[k + 1] = prefix[k] + (covered[k] ? 1 : 0);
+  return prefix;
+}
+
+double coveredFraction(const std::vector<int>& prefix, int from, int to) {
+  if (to <= from) return 0.0;
+  const int length = static_cast<int>(prefix.size()) - 1;
+  const int a = std::clamp(from, 0, length), b = std::clamp(to, 0, length);
+  return static_cast<double>(prefix[b] - prefix[a]) / (to - from);
+}
+
+void buildGrid(const OccupancyGrid& map, const LayoutOptions& options, Layout* layout) {
+  CellGrid& grid = layout->grid;
+  grid = CellGrid();
+  for (const ExtendedLine& line : layout->lines)
+    (line.axis == LineAxis::kHorizontal ? grid.ys : grid.xs).push_back(line.position);
+  std::sort(grid.xs.begin(), grid.xs.end());
+  std::sort(grid.ys.begin(), grid.ys.end());
+  grid.xs.erase(std::unique(grid.xs.begin(), grid.xs.end()), grid.xs.end());
+  grid.ys.erase(std::unique(grid.ys.begin(), grid.ys.end()), grid.ys.end());
+
+  const cv::Rect image(0, 0, map.width(), map.height());
+  cv::Mat1i unknown_integral;
+  cv::integral(cv::Mat1b(map.cells == OccupancyGrid::kUnknown) / 255, unknown_integral, CV_32S);
+  const int columns = grid.columns(), rows = grid.rows();
+  grid.cells.resize(static_cast<size_t>(columns) * rows);
+  for (int j = 0; j < rows; ++j)
+    for (int i = 0; i < columns; ++i) {
+      LayoutCell& cell = grid.cells[grid.index(i, j)];
+      cell.rect = cv::Rect(grid.xs[i], grid.ys[j], grid.xs[i + 1] - grid.xs[i], grid.ys[j + 1] - grid.ys[j]);
+      cell.border = i == 0 || j == 0 || i == columns - 1 || j == rows - 1;
+      const cv::Rect inside = cell.rect & image;
+      double unknown = static_cast<double>(cell.rect.area()) - inside.area();  // past the image: unknown
+      if (inside.area() > 0)
+        unknown += unknown_integral(inside.br().y, inside.br().x) - unknown_integral(inside.y, inside.br().x) -
+                   unknown_integral(inside.br().y, inside.x) + unknown_integral(inside.y, inside.x);
+      cell.unknown_fraction = unknown / cell.rect.area();
+      cell.out = cell.unknown_fraction > options.out_unknown_fraction;
+    }
+
+  // Wall fraction of every inner edge: the share of its pixels with an occupied pixel within the band.
+  const cv::Mat1b occupied = cv::Mat1b(map.cells == OccupancyGrid::kOccupied) / 255;
+  const int band = toPixels(options.wall_coverage_band, map.resolution, 1);
+  grid.right_wall.assign(grid.cells.size(), 0.0);
+  grid.below_wall.assign(grid.cells.size(), 0.0);
+  for (int i = 0; i + 1 < columns; ++i) {
+    const std::vector<int> prefix = coveragePrefix(occupied, LineAxis::kVertical, grid.xs[i + 1], band);
+    for (int j = 0; j < rows; ++j)
+      grid.right_wall[grid.index(i, j)] = coveredFraction(prefix, grid.ys[j], grid.ys[j + 1]);
+  }
+  for (int j = 0; j + 1 < rows; ++j) {
+    const std::vector<int> prefix = coveragePrefix(occupied, LineAxis::kHorizontal, grid.ys[j + 1], band);
+    for (int i = 0; i < columns; ++i)
+      grid.below_wall[grid.index(i, j)] = coveredFraction(prefix, grid.xs[i], grid.xs[i + 1]);
+  }
+}
+
+// DBSCAN of the IN cells. Distance between edge-adjacent cells: 1 - exp(-w / sigma) with w the wall fraction of
+// their shared edge (the affinity L of METHOD.md §3.6 turned into a distance); any other pair of distinct cells
+// has affinity 0, distance 1 > eps, so a neighbourhood is the cell itself plus its edge-adjacent IN cells with
+// w <= -sigma ln(1 - eps) (0.19 with the defaults). With min_points 1 the rooms are the connected components
+// of that graph. DBSCAN's noise cells (possible with min_points > 1) each become a room of their own, so that
+// every IN cell has a room.
+int segmentRooms(const LayoutOptions& options, CellGrid* grid) {
+  const int count = grid->size();
+  const int min_points = static_cast<int>(std::lround(options.dbscan_min_points));
+  auto neighbourhood = [&](int cell) {
+    std::vector<int> near{cell};
+    for (int other : grid->edgeNeighbours(cell)) {
+      if (grid->cells[other].out) continue;
+      const double distance = 1.0 - std::exp(-grid->wallFraction(cell, other) / options.affinity_sigma);
+      if (distance <= options.dbscan_eps) near.push_back(other);
+    }
+    return near;
+  };
+  constexpr int kUnvisited = -2, kNoise = -1;
+  std::vector<int> label(count, kUnvisited);
+  int rooms = 0;
+  for (int cell = 0; cell < count; ++cell) {
+    if (grid->cells[cell].out || label[cell] != kUnvisited) continue;
+    const std::vector<int> near = neighbourhood(cell);
+    if (static_cast<int>(near.size()) < min_points) {
+      label[cell] = kNoise;
+      continue;
+    }
+    const int room = rooms++;
+    label[cell] = room;
+    std::vector<int> queue(near.begin() + 1, near.end());
+    while (!queue.empty()) {
+      const int next = queue.back();
+      queue.pop_back();
+      if (label[next] == kNoise) label[next] = room;  // border point
+      if (label[next] != kUnvisited) continue;
+      label[next] = room;
+      const std::vector<int> next_near = neighbourhood(next);
+      if (static_cast<int>(next_near.size()) >= min_points)
+        queue.insert(queue.end(), next_near.begin() + 1, next_near.end());
+    }
+  }
+  for (int cell = 0; cell < count; ++cell) {
+    if (grid->cells[cell].out) continue;
+    if (label[cell] == kNoise) label[cell] = rooms++;
+    grid->cells[cell].room = label[cell];
+  }
+  return rooms;
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Doors (METHOD.md §4.1): the nearest grid edge between an IN and an OUT cell, preferring edges parallel to
+// the door line (an O door lies on a horizontal edge, a V door on a vertical one) and falling back to the
+// other orientation when no parallel edge is within the search radius.
+
+double distanceToImageSegment(const Point2& p, const ImageSegment& s) { return distanceToSegment(p, s.a, s.b); }
+
+std::vector<DoorStart> placeDoors(const OccupancyGrid& map, const std::vector<MapDoor>& doors,
+                                  const LayoutOptions& options, const CellGrid& grid) {
+  struct Candidate {
+    int out_cell, in_cell;
+    ImageSegment edge;
+    bool horizontal;
+  };
+  std::vector<Candidate> candidates;
+  for (int cell = 0; cell < grid.size(); ++cell)
+    for (int other : {grid.column(cell) + 1 < grid.columns() ? cell + 1 : -1,
+                      grid.row(cell) + 1 < grid.rows() ? cell + grid.columns() : -1}) {
+      if (other < 0 || grid.cells[cell].out == grid.cells[other].out) continue;
+      Candidate candidate;
+      candidate.out_cell = grid.cells[cell].out ? cell : other;
+      candidate.in_cell = grid.cells[cell].out ? other : cell;
+      grid.sharedEdge(cell, other, &candidate.edge);
+      candidate.horizontal = other != cell + 1;
+      candidates.push_back(candidate);
+    }
+
+  const double radius_pixels = toPixelDistance(options.door_search_radius, map.resolution);
+  std::vector<DoorStart> starts;
+  for (const MapDoor& door : doors) {
+    DoorStart start;
+    start.door_id = door.id;
+    int col = 0, row = 0;
+    if (!map.cellOf(door.position, &col, &row)) {
+      start.problem = "door position (" + formatNumber(door.position.x()) + ", " + formatNumber(door.position.y()) +
+                      ") is outside the map";
+      starts.push_back(start);
+      continue;
+    }
+    const Point2 p = map.toImage(door.position);
+    const bool door_horizontal = door.orientation == DoorOrientation::kAlongX;
+    const Candidate* best = nullptr;
+    double best_distance = std::numeric_limits<double>::infinity();
+    for (bool parallel_only : {true, false}) {
+      for (const Candidate& candidate : candidates) {
+        if (parallel_only && candidate.horizontal != door_horizontal) continue;
+        const double distance = distanceToImageSegment(p, candidate.edge);
+        if (distance <= radius_pixels && distance < best_distance) {
+          best_distance = distance;
+          best = &candidate;
+        }
+      }
+      if (best != nullptr) break;
+    }
+    if (best == nullptr) {
+      start.problem = "no cell edge between explored and unknown space within " +
+                      formatNumber(options.door_search_radius) + " m of the door";
+      starts.push_back(start);
+      continue;
+    }
+    start.found = true;
+    start.start_cell = best->out_cell;
+    start.explored_cell = best->in_cell;
+    start.edge = best->edge;
+    const Point2 centre = 0.5 * (best->edge.a + best->edge.b);
+    start.position = map.origin + map.resolution * Point2(centre.x(), map.height() - centre.y());
+    start.distance = best_distance * map.resolution;
+    starts.push_back(start);
+  }
+  return starts;
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Debug images
+
+cv::Scalar paletteColour(int k) {
+  cv::Mat3b hsv(1, 1, cv::Vec3b(static_cast<uint8_t>(std::fmod(k * 137.508, 360.0) / 2), 210, 225));
+  cv::Mat3b bgr;
+  cv::cvtColor(hsv, bgr, cv::COLOR_HSV2BGR);
+  return cv::Scalar(bgr(0, 0)[0], bgr(0, 0)[1], bgr(0, 0)[2]);
+}
+
+// A canvas covering the image and the cell grid, with the map drawn at its place.
+class DebugCanvas {
+ public:
+  DebugCanvas(const Layout& layout, const cv::Mat1b& grey) : grey_(grey) {
+    cv::Rect bounds(cv::Point(0, 0), layout.image_size);
+    const CellGrid& grid = layout.grid;
+    if (grid.columns() > 0 && grid.rows() > 0)
+      bounds |= cv::Rect(cv::Point(grid.xs.front(), grid.ys.front()),
+                         cv::Point(grid.xs.back() + 1, grid.ys.back() + 1));
+    offset_ = -bounds.tl();
+    size_ = bounds.size();
+  }
+
+  // The map in colour, faded towards white by `fade` in [0, 1]; the area past the image is unknown grey.
+  cv::Mat3b map(double fade = 0.0) const {
+    cv::Mat3b canvas(size_, cv::Vec3b(205, 205, 205));
+    cv::Mat3b colour;
+    cv::cvtColor(grey_, colour, cv::COLOR_GRAY2BGR);
+    colour.copyTo(canvas(cv::Rect(offset_, grey_.size())));
+    if (fade > 0) canvas = canvas * (1.0 - fade) + cv::Scalar::all(255 * fade);
+    return canvas;
+  }
+
+  cv::Point at(const Point2& p) const {
+    return cv::Point(static_cast<int>(std::lround(p.x())), static_cast<int>(std::lround(p.y()))) + offset_;
+  }
+  cv::Rect at(const cv::Rect& r) const { return cv::Rect(r.tl() + offset_, r.size()) & cv::Rect(cv::Point(), size_); }
+  cv::Size size() const { return size_; }
+
+  // Occupied pixels of the map drawn black over `canvas`.
+  void drawWalls(cv::Mat3b* canvas) const {
+    (*canvas)(cv::Rect(offset_, grey_.size())).setTo(cv::Scalar::all(0), grey_ == 0);
+  }
+
+  void drawGridLines(const Layout& layout, cv::Mat3b* canvas, const cv::Scalar& colour) const {
+    const CellGrid& grid = layout.grid;
+    if (grid.columns() == 0 || grid.rows() == 0) return;
+    for (int x : grid.xs) cv::line(*canvas, at(Point2(x, grid.ys.front())), at(Point2(x, grid.ys.back())), colour, 1);
+    for (int y : grid.ys) cv::line(*canvas, at(Point2(grid.xs.front(), y)), at(Point2(grid.xs.back(), y)), colour, 1);
+  }
+
+ private:
+  cv::Mat1b grey_;
+  cv::Point offset_;
+  cv::Size size_;
+};
+
+void writeImage(const std::string& dir, const std::string& name, const cv::Mat& image) {
+  const std::string path = (std::filesystem::path(dir) / name).string();
+  hidden_rooms::writeImage(path, image);
+}
+
+void blend(cv::Mat3b* canvas, const cv::Rect& rect, const cv::Scalar& colour, double alpha) {
+  if (rect.area() <= 0) return;
+  cv::Mat3b region = (*canvas)(rect);
+  cv::Mat3b tint(region.size(), cv::Vec3b(colour[0], colour[1], colour[2]));
+  cv::addWeighted(region, 1.0 - alpha, tint, alpha, 0.0, region);
+}
+
+void writeDebugImages(const std::string& dir, const OccupancyGrid& map, const std::vector<MapDoor>& doors,
+                      const cv::Mat1b& grey, const cv::Mat1b& edges, const Layout& layout) {
+  std::error_code error;
+  std::filesystem::create_directories(dir, error);
+  if (!std::filesystem::is_directory(dir)) throw InputError(dir, "cannot create debug folder");
+
+  const DebugCanvas canvas(layout, grey);
+  writeImage(dir, "edges.png", edges);
+
+  cv::Mat3b segments = canvas.map(0.5);
+  for (const ImageSegment& s : layout.segments)
+    cv::line(segments, canvas.at(s.a), canvas.at(s.b), cv::Scalar(0, 0, 255), 1);
+  writeImage(dir, "segments.png", segments);
+
+  cv::Mat3b angular = canvas.map(0.7);
+  for (size_t s = 0; s < layout.segments.size(); ++s)
+    cv::line(angular, canvas.at(layout.segments[s].a), canvas.at(layout.segments[s].b),
+             paletteColour(layout.segment_angular_cluster[s]), 2);
+  for (int m = 0; m < static_cast<int>(layout.angular_modes.size()); ++m) {
+    double degrees = layout.angular_modes[m] * 180.0 / CV_PI;  // shown in [-45, 135): 179.9 as -0.1
+    if (degrees >= 135.0) degrees -= 180.0;
+    cv::putText(angular, formatNumber(std::round(degrees * 10) / 10 + 0.0) + " deg", cv::Point(5, 15 + 15 * m),
+                cv::FONT_HERSHEY_SIMPLEX, 0.4, paletteColour(m), 1);
+  }
+  writeImage(dir, "angular_clusters.png", angular);
+
+  cv::Mat3b walls = canvas.map(0.7);
+  for (size_t w = 0; w < layout.walls.size(); ++w) {
+    const cv::Scalar colour = paletteColour(static_cast<int>(w));
+    for (int s : layout.walls[w].segments)
+      cv::line(walls, canvas.at(layout.segments[s].a), canvas.at(layout.segments[s].b),
+               colour * 0.5 + cv::Scalar::all(127), 1);
+    cv::line(walls, canvas.at(layout.walls[w].segment.a), canvas.at(layout.walls[w].segment.b), colour, 2);
+  }
+  writeImage(dir, "walls.png", walls);
+
+  const CellGrid& grid = layout.grid;
+  const bool has_grid = grid.columns() > 0 && grid.rows() > 0;
+  cv::Mat3b lines = canvas.map(0.5);
+  if (has_grid)
+    for (const ExtendedLine& line : layout.lines) {
+      const cv::Scalar colour = line.source == LineSource::kWall       ? cv::Scalar(200, 80, 0)
+                                : line.source == LineSource::kDoorPair ? cv::Scalar(200, 0, 200)
+                                                                       : cv::Scalar(0, 160, 0);
+      const bool horizontal = line.axis == LineAxis::kHorizontal;
+      const Point2 a = horizontal ? Point2(grid.xs.front(), line.position) : Point2(line.position, grid.ys.front());
+      const Point2 b = horizontal ? Point2(grid.xs.back(), line.position) : Point2(line.position, grid.ys.back());
+      cv::line(lines, canvas.at(a), canvas.at(b), colour, 1);
+    }
+  for (const MapDoor& door : doors)
+    cv::circle(lines, canvas.at(map.toImage(door.position)), 4, cv::Scalar(0, 0, 255), 2);
+  cv::putText(lines, "wall", cv::Point(5, 15), cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(200, 80, 0), 1);
+  cv::putText(lines, "door pair", cv::Point(5, 30), cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(200, 0, 200), 1);
+  cv::putText(lines, "boundary", cv::Point(5, 45), cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(0, 160, 0), 1);
+  writeImage(dir, "extended_lines.png", lines);
+
+  // Cells: IN white, OUT grey, border cells tinted orange; the map's walls in black; grid lines light blue;
+  // the faded map past the grid.
+  cv::Mat3b cells = canvas.map(0.6);
+  for (const LayoutCell& cell : grid.cells) {
+    const cv::Rect rect = canvas.at(cell.rect);
+    cells(rect).setTo(cell.out ? cv::Scalar::all(150) : cv::Scalar::all(255));
+    if (cell.border) blend(&cells, rect, cv::Scalar(0, 140, 255), 0.35);
+  }
+  canvas.drawWalls(&cells);
+  canvas.drawGridLines(layout, &cells, cv::Scalar(230, 190, 120));
+  writeImage(dir, "cells.png", cells);
+
+  // Rooms: IN cells coloured by room, OUT cells grey (border cells darker).
+  cv::Mat3b rooms = canvas.map(0.6);
+  for (const LayoutCell& cell : grid.cells) {
+    const cv::Rect rect = canvas.at(cell.rect);
+    rooms(rect).setTo(!cell.out     ? paletteColour(cell.room) * 0.6 + cv::Scalar::all(100)
+                      : cell.border ? cv::Scalar::all(120)
+                                    : cv::Scalar::all(150));
+  }
+  canvas.drawWalls(&rooms);
+  canvas.drawGridLines(layout, &rooms, cv::Scalar(90, 90, 90));
+  writeImage(dir, "rooms.png", rooms);
+
+  cv::Mat3b starts = canvas.map(0.3);
+  canvas.drawGridLines(layout, &starts, cv::Scalar(230, 190, 120));
+  for (size_t d = 0; d < layout.doors.size() && d < doors.size(); ++d) {
+    const DoorStart& start = layout.doors[d];
+    const cv::Point door = canvas.at(map.toImage(doors[d].position));
+    const cv::Scalar colour = paletteColour(static_cast<int>(d));
+    if (start.found) {
+      blend(&starts, canvas.at(grid.cells[start.start_cell].rect), colour, 0.5);
+      cv::line(starts, canvas.at(start.edge.a), canvas.at(start.edge.b), cv::Scalar(0, 0, 255), 3);
+      cv::circle(starts, door, 4, cv::Scalar(0, 0, 0), 2);
+    } else {
+      cv::drawMarker(starts, door, cv::Scalar(0, 0, 255), cv::MARKER_TILTED_CROSS, 12, 2);
+    }
+    cv::putText(starts, std::to_string(doors[d].id), door + cv::Point(6, -6), cv::FONT_HERSHEY_SIMPLEX, 0.5,
+                cv::Scalar(0, 0, 0), 2);
+  }
+  writeImage(dir, "start_cells.png", starts);
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------------------
+
+Layout analyzeLayout(const OccupancyGrid& map, const std::vector<MapDoor>& closed_doors, const LayoutOptions& options,
+                     const std::string& debug_dir) {
+  if (map.empty()) throw InputError("map", "the map is empty");
+  if (!(map.resolution > 0.0) || !std::isfinite(map.resolution))
+    throw InputError("map", "resolution must be positive");
+  validateLayoutOptions(options);
+  const double resolution = map.resolution;
+
+  Layout layout;
+  layout.image_size = map.cells.size();
+  layout.resolution = resolution;
+
+  // Walls as edges of the thresholded image (free and unknown turn white, occupied black), then segments.
+  const cv::Mat1b grey = map.toGreyImage();
+  cv::Mat1b binary, edges;
+  cv::threshold(grey, binary, options.binary_threshold, 255, cv::THRESH_BINARY);
+  cv::Canny(binary, edges, options.canny_low_threshold, options.canny_high_threshold,
+            static_cast<int>(options.canny_aperture));
+  std::vector<cv::Vec4i> hough;
+  cv::HoughLinesP(edges, hough, options.hough_rho, options.hough_theta,
+                  toPixels(options.hough_threshold, resolution, 1),
+                  toPixelDistance(options.hough_min_line_length, resolution),
+                  toPixelDistance(options.hough_max_line_gap, resolution));
+  for (const cv::Vec4i& h : hough) {
+    ImageSegment segment;  // pixel centres
+    segment.a = Point2(h[0] + 0.5, h[1] + 0.5);
+    segment.b = Point2(h[2] + 0.5, h[3] + 0.5);
+    layout.segments.push_back(segment);
+  }
+
+  clusterAngles(options.angular_bandwidth, &layout);
+  clusterWalls(toPixelDistance(options.wall_cluster_distance, resolution), &layout);
+
+  // Bounding box of the segments (the whole image when there are none) and the boundary lines around it.
+  if (layout.segments.empty()) {
+    layout.segment_box = cv::Rect2d(0, 0, map.width(), map.height());
+  } else {
+    double x0 = std::numeric_limits<double>::infinity(), y0 = x0, x1 = -x0, y1 = -x0;
+    for (const ImageSegment& s : layout.segments)
+      for (const Point2& p : {s.a, s.b}) {
+        x0 = std::min(x0, p.x());
+        y0 = std::min(y0, p.y());
+        x1 = std::max(x1, p.x());
+        y1 = std::max(y1, p.y());
+      }
+    layout.segment_box = cv::Rect2d(x0, y0, x1 - x0, y1 - y0);
+  }
+  const int offset = toPixels(options.boundary_offset, resolution, 1);
+  const cv::Rect boundary(cv::Point(static_cast<int>(std::floor(layout.segment_box.x)) - offset,
+                                    static_cast<int>(std::floor(layout.segment_box.y)) - offset),
+                          cv::Point(static_cast<int>(std::ceil(layout.segment_box.br().x)) + offset,
+                                    static_cast<int>(std::ceil(layout.segment_box.br().y)) + offset));
+
+  const double merge_distance = toPixelDistance(options.line_merge_distance, resolution);
+  std::vector<ExtendedLine> lines = wallLines(layout, merge_distance);
+  if (options.door_pair_lines != 0) {
+    std::vector<Point2> door_points;
+    for (const MapDoor& door : closed_doors) {
+      int col = 0, row = 0;
+      if (map.cellOf(door.position, &col, &row)) door_points.push_back(map.toImage(door.position));
+    }
+    addDoorPairLines(door_points, boundary, merge_distance, &lines);
+  }
+  // Boundary lines last; lines on or past them (or within the merge distance) give way.
+  std::vector<ExtendedLine> horizontal, vertical;
+  for (const ExtendedLine& line : lines) {
+    const bool is_horizontal = line.axis == LineAxis::kHorizontal;
+    const int low = is_horizontal ? boundary.y : boundary.x;
+    const int high = is_horizontal ? boundary.br().y : boundary.br().x;
+    if (line.position <= low || line.position >= high) continue;
+    (is_horizontal ? horizontal : vertical).push_back(line);
+  }
+  for (int position : {boundary.y, boundary.br().y})
+    horizontal.push_back({LineAxis::kHorizontal, position, LineSource::kBoundary, -1});
+  for (int position : {boundary.x, boundary.br().x})
+    vertical.push_back({LineAxis::kVertical, position, LineSource::kBoundary, -1});
+  layout.lines = mergeLines(horizontal, merge_distance, layout);
+  const std::vector<ExtendedLine> merged_vertical = mergeLines(vertical, merge_distance, layout);
+  layout.lines.insert(layout.lines.end(), merged_vertical.begin(), merged_vertical.end());
+
+  buildGrid(map, options, &layout);
+  layout.room_count = segmentRooms(options, &layout.grid);
+  layout.doors = placeDoors(map, closed_doors, options, layout.grid);
+
+  if (!debug_dir.empty()) writeDebugImages(debug_dir, map, closed_doors, grey, edges, layout);
+  return layout;
+}
+
+}  // namespace hidden_rooms

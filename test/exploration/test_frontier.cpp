@@ -1,0 +1,307 @@
+// Frontier extraction (groups, small ones and unknown specks dropped) and the nearest-frontier goal by path cost.
+#include <algorithm>
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "hidden_rooms/common/input_error.h"
+#include "hidden_rooms/exploration/frontier.h"
+#include "hidden_rooms/exploration/grid_planner.h"
+
+namespace hidden_rooms {
+namespace {
+
+// 0.1 m cells, origin (0, 0); the whole grid unknown.
+OccupancyGrid unknownGrid(int cols, int rows) {
+  OccupancyGrid grid;
+  grid.resolution = 0.1;
+  grid.cells = cv::Mat_<int8_t>(rows, cols, OccupancyGrid::kUnknown);
+  return grid;
+}
+
+TEST(Frontier, EmptyMapHasNone) {
+  const FrontierMap frontiers = findFrontiers(OccupancyGrid());
+  EXPECT_TRUE(frontiers.frontiers.empty());
+}
+
+TEST(Frontier, FullyKnownRoomHasNone) {
+  OccupancyGrid grid = unknownGrid(30, 20);
+  grid.cells.setTo(OccupancyGrid::kOccupied);
+  grid.cells(cv::Rect(1, 1, 28, 18)).setTo(OccupancyGrid::kFree);
+  EXPECT_TRUE(findFrontiers(grid).frontiers.empty());
+}
+
+TEST(Frontier, GroupsTwoOpeningsAndDropsSmallOnes) {
+  // A walled free room (cols 5..24, rows 5..14) in unknown space with two gaps in its walls: 6 cells on the left
+  // wall and 2 cells on the right wall, which is below min_frontier_cells.
+  OccupancyGrid grid = unknownGrid(40, 20);
+  grid.cells(cv::Rect(4, 4, 22, 12)).setTo(OccupancyGrid::kOccupied);
+  grid.cells(cv::Rect(5, 5, 20, 10)).setTo(OccupancyGrid::kFree);
+  grid.cells(cv::Rect(4, 7, 1, 6)).setTo(OccupancyGrid::kFree);   // left gap: rows 7..12
+  grid.cells(cv::Rect(25, 9, 1, 2)).setTo(OccupancyGrid::kFree);  // right gap: rows 9..10
+  FrontierOptions options;
+  options.min_frontier_cells = 4;
+  const FrontierMap frontiers = findFrontiers(grid, options);
+  ASSERT_EQ(frontiers.frontiers.size(), 1u);
+  const Frontier& left = frontiers.frontiers[0];
+  EXPECT_EQ(left.label, 1);
+  EXPECT_EQ(left.cells.size(), 6u);  // the gap cells touch unknown on their left
+  EXPECT_NEAR(left.centroid.x(), 0.45, 1e-9);
+  EXPECT_NEAR(left.centroid.y(), 1.0, 1e-9);  // rows 7..12 of 20 -> y from 1.25 down to 0.75
+  for (const cv::Point& cell : left.cells) EXPECT_EQ(frontiers.labels(cell.y, cell.x), 1);
+  EXPECT_EQ(frontiers.labels(10, 25), 0);
+
+  options.min_frontier_cells = 2;
+  const FrontierMap with_small = findFrontiers(grid, options);
+  ASSERT_EQ(with_small.frontiers.size(), 2u);
+  EXPECT_EQ(with_small.frontiers[0].cells.size(), 6u);  // largest first
+  EXPECT_EQ(with_small.frontiers[1].cells.size(), 2u);
+}
+
+TEST(Frontier, IgnoresUnknownSpecksAndCountsTheGridEdgeAsUnknown) {
+  OccupancyGrid grid = unknownGrid(30, 20);
+  grid.cells.setTo(OccupancyGrid::kFree);
+  grid.cells(cv::Rect(10, 10, 2, 2)).setTo(OccupancyGrid::kUnknown);  // a 4-cell speck
+  FrontierOptions options;
+  options.min_unknown_cells = 5;
+  options.min_frontier_cells = 1;
+  const FrontierMap frontiers = findFrontiers(grid, options);
+  // Only the free border (beyond which nothing is known): one ring of 2 * 30 + 2 * 18 cells.
+  ASSERT_EQ(frontiers.frontiers.size(), 1u);
+  EXPECT_EQ(frontiers.frontiers[0].cells.size(), 96u);
+  EXPECT_EQ(frontiers.labels(9, 10), 0);
+
+  options.min_unknown_cells = 4;
+  EXPECT_EQ(findFrontiers(grid, options).frontiers.size(), 2u);  // now the speck's 8-cell ring counts
+}
+
+TEST(Frontier, UncertainCellsCountAsUnknown) {
+  // A free room whose right part (cols 20..29) was seen too rarely to be free or occupied (value 40).
+  OccupancyGrid grid = unknownGrid(30, 20);
+  grid.cells.setTo(OccupancyGrid::kOccupied);
+  grid.cells(cv::Rect(1, 1, 28, 18)).setTo(OccupancyGrid::kFree);
+  grid.cells(cv::Rect(20, 1, 9, 18)).setTo(40);
+  const FrontierMap frontiers = findFrontiers(grid);
+  ASSERT_EQ(frontiers.frontiers.size(), 1u);
+  EXPECT_EQ(frontiers.frontiers[0].cells.size(), 18u);  // column 19
+  for (const cv::Point& cell : frontiers.frontiers[0].cells) EXPECT_EQ(cell.x, 19);
+}
+
+// A 10 m x 4 m free corridor (0.1 m cells) closed by walls, with unknown strips at both ends behind gaps:
+// frontier at the left end (x ~ 0.2) and at the right end (x ~ 9.8).
+OccupancyGrid corridorWithTwoEnds() {
+  OccupancyGrid grid = unknownGrid(100, 40);
+  grid.cells(cv::Rect(2, 0, 96, 40)).setTo(OccupancyGrid::kOccupied);
+  grid.cells(cv::Rect(2, 1, 96, 38)).setTo(OccupancyGrid::kFree);
+  return grid;
+}
+
+TEST(Frontier, NearestGoalIsTheCheaperEndAndSkipsTheBlacklist) {
+  const OccupancyGrid grid = corridorWithTwoEnds();
+  GridPlanner planner;
+  planner.setMap(grid);
+  ASSERT_TRUE(planner.computeCostsFrom(Point2(7.0, 2.0)));
+  const FrontierMap frontiers = findFrontiers(grid);
+  ASSERT_EQ(frontiers.frontiers.size(), 2u);
+  FrontierOptions options;
+  const std::optional<FrontierGoal> goal = nearestFrontierGoal(frontiers, planner, Blacklist(), options);
+  ASSERT_TRUE(goal.has_value());
+  EXPECT_GT(goal->position.x(), 9.0);   // the right end is 3 m away, the left one 7 m
+  EXPECT_LE(std::abs(goal->position.x() - 9.75), options.goal_reach + 1e-6);  // frontier cells at x = 9.75
+  EXPECT_NEAR(goal->cost, planner.costTo(goal->cell.x, goal->cell.y), 1e-12);
+  EXPECT_LT(goal->cost, 4.0);
+
+  Blacklist blacklist;
+  blacklist.radius = 3.0;
+  blacklist.points.push_back(Point2(9.8, 2.0));
+  const std::optional<FrontierGoal> other = nearestFrontierGoal(frontiers, planner, blacklist, options);
+  ASSERT_TRUE(other.has_value());
+  EXPECT_LT(other->position.x(), 1.0);
+  EXPECT_GT(other->cost, 5.5);
+
+  // Hysteresis: a previous goal at the left end is kept only while it costs at most `hysteresis` more.
+  EXPECT_GT(nearestFrontierGoal(frontiers, planner, Blacklist(), options, other->position, 1.0)->position.x(), 9.0);
+  EXPECT_LT(nearestFrontierGoal(frontiers, planner, Blacklist(), options, other->position, 100.0)->position.x(), 1.0);
+}
+
+// The corridor with two frontier ends, searched from (7, 2), and a blacklist whose radius covers either end.
+class BlacklistRelease : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    planner_.setMap(grid_);
+    ASSERT_TRUE(planner_.computeCostsFrom(Point2(7.0, 2.0)));
+    blacklist_.radius = 3.0;
+  }
+  std::optional<FrontierGoal> goal() const {
+    return nearestFrontierGoal(frontiers_, planner_, blacklist_, FrontierOptions());
+  }
+  const OccupancyGrid grid_ = corridorWithTwoEnds();
+  const FrontierMap frontiers_ = findFrontiers(grid_);
+  GridPlanner planner_;
+  Blacklist blacklist_;
+};
+
+TEST_F(BlacklistRelease, PlacesWhereTheRobotWasStuckAreTriedAgain) {
+  EXPECT_TRUE(blacklist_.add(Point2(9.8, 2.0), GoalOutcome::kRobotStuck));  // failed, the robot could not move
+  EXPECT_FALSE(blacklist_.add(Point2(0.2, 2.0), GoalOutcome::kReached));    // reached, its frontier still there
+  EXPECT_FALSE(goal().has_value());
+  EXPECT_EQ(blacklist_.releaseFailed(), 0u);
+  EXPECT_EQ(blacklist_.releaseStuck(), 1u);
+  EXPECT_EQ(blacklist_.points.size(), 1u);
+  EXPECT_TRUE(blacklist_.stuck_points.empty());
+  const std::optional<FrontierGoal> again = goal();
+  ASSERT_TRUE(again.has_value());
+  EXPECT_GT(again->position.x(), 9.0);
+  EXPECT_EQ(blacklist_.releaseStuck(), 0u);
+  // Stuck there again: released again next time (the recoveries are what may free the robot).
+  blacklist_.add(again->position, GoalOutcome::kRobotStuck);
+  EXPECT_FALSE(goal().has_value());
+  EXPECT_EQ(blacklist_.releaseStuck(), 1u);
+}
+
+TEST_F(BlacklistRelease, FailedPlacesGetOneSecondTry) {
+  EXPECT_FALSE(blacklist_.add(Point2(0.2, 2.0), GoalOutcome::kReached));
+  EXPECT_TRUE(blacklist_.add(Point2(9.8, 2.0), GoalOutcome::kFailed));
+  EXPECT_FALSE(goal().has_value());
+  EXPECT_EQ(blacklist_.releaseStuck(), 0u);
+  // The failed place is released, the reached one is not.
+  EXPECT_EQ(blacklist_.releaseFailed(), 1u);
+  ASSERT_EQ(blacklist_.points.size(), 1u);
+  EXPECT_EQ(blacklist_.points[0], Point2(0.2, 2.0));
+  const std::optional<FrontierGoal> again = goal();
+  ASSERT_TRUE(again.has_value());
+  EXPECT_GT(again->position.x(), 9.0);
+  // It fails again (near the retried place): blacklisted for good.
+  EXPECT_FALSE(blacklist_.add(again->position, GoalOutcome::kFailed));
+  EXPECT_TRUE(blacklist_.failed_points.empty());
+  EXPECT_EQ(blacklist_.releaseFailed(), 0u);
+  EXPECT_FALSE(goal().has_value());
+  // A failure elsewhere gets its own second try.
+  EXPECT_TRUE(blacklist_.add(Point2(5.0, 9.0), GoalOutcome::kFailed));
+  EXPECT_EQ(blacklist_.releaseFailed(), 1u);
+  EXPECT_EQ(blacklist_.points.size(), 2u);
+}
+
+// A straight path along y = 2 from x = 0 to x = 5 in 0.05 m steps.
+std::vector<Point2> straightPath() {
+  std::vector<Point2> path;
+  for (int i = 0; i <= 100; ++i) path.emplace_back(0.05 * i, 2.0);
+  return path;
+}
+
+TEST(BlockedPassages, TwoFailuresFromOnePlaceBlockThePathAheadOfTheRobot) {
+  BlockedPassages passages;  // 2 failures, same place within 0.5 m, stretch 0.25..1.0 m ahead
+  EXPECT_FALSE(passages.addFailure(Point2(2.0, 2.1), straightPath()));
+  EXPECT_TRUE(passages.blockedPoints().empty());
+  EXPECT_FALSE(passages.addFailure(Point2(4.0, 2.0), straightPath()));  // another place
+  EXPECT_TRUE(passages.blockedPoints().empty());
+  EXPECT_TRUE(passages.addFailure(Point2(2.3, 2.0), straightPath()));  // 0.3 m from the first, same way
+  ASSERT_FALSE(passages.blockedPoints().empty());
+  for (const Point2& point : passages.blockedPoints()) {
+    EXPECT_GE(point.x(), 2.0 + 0.25 - 1e-9);  // ahead of the first failure's robot, not where it stood ...
+    EXPECT_LE(point.x(), 2.3 + 1.0 + 1e-9);   // ... up to 1 m ahead of the second's
+  }
+  // The failure at x = 4 is still pending: one more there blocks its stretch too; a release opens all, once.
+  EXPECT_TRUE(passages.addFailure(Point2(4.1, 2.0), straightPath()));
+  EXPECT_GT(passages.releaseOnce(), 0u);
+  EXPECT_TRUE(passages.blockedPoints().empty());
+  EXPECT_FALSE(passages.addFailure(Point2(1.0, 2.0), straightPath()));
+  EXPECT_TRUE(passages.addFailure(Point2(1.0, 2.0), straightPath()));
+  EXPECT_EQ(passages.releaseOnce(), 0u);  // blocked for good now
+  EXPECT_FALSE(passages.blockedPoints().empty());
+
+  // Failures from one place in different directions: the robot is stuck there; what was blocked from there is
+  // opened, and later failures there block nothing.
+  BlockedPassages wedged;
+  std::vector<Point2> back = straightPath();
+  std::reverse(back.begin(), back.end());
+  EXPECT_FALSE(wedged.addFailure(Point2(2.0, 2.0), straightPath()));
+  EXPECT_TRUE(wedged.addFailure(Point2(2.1, 2.0), straightPath()));
+  EXPECT_FALSE(wedged.blockedPoints().empty());
+  EXPECT_TRUE(wedged.addFailure(Point2(2.0, 2.0), back));  // the other way
+  EXPECT_TRUE(wedged.blockedPoints().empty());
+  for (int i = 0; i < 3; ++i) EXPECT_FALSE(wedged.addFailure(Point2(2.0, 2.1), straightPath()));
+  EXPECT_TRUE(wedged.blockedPoints().empty());
+
+  BlockedPassagesOptions never;
+  never.failures = 0;
+  BlockedPassages off(never);
+  for (int i = 0; i < 3; ++i) EXPECT_FALSE(off.addFailure(Point2(2.0, 2.0), straightPath()));
+  EXPECT_TRUE(off.blockedPoints().empty());
+  BlockedPassagesOptions bad;
+  bad.skip = 2.0;  // beyond length
+  EXPECT_THROW(BlockedPassages{bad}, InputError);
+  bad = BlockedPassagesOptions();
+  bad.radius = -0.1;
+  EXPECT_THROW(BlockedPassages{bad}, InputError);
+}
+
+TEST(Frontier, UnreachableFrontierGivesNoGoal) {
+  // A frontier in a second room that a wall separates from the robot's.
+  OccupancyGrid grid = corridorWithTwoEnds();
+  grid.cells(cv::Rect(50, 0, 2, 40)).setTo(OccupancyGrid::kOccupied);  // wall across at x = 5.0..5.2
+  grid.cells(cv::Rect(0, 0, 2, 40)).setTo(OccupancyGrid::kOccupied);   // left end closed: only the right frontier
+  GridPlanner planner;
+  planner.setMap(grid);
+  ASSERT_TRUE(planner.computeCostsFrom(Point2(2.0, 2.0)));
+  const FrontierMap frontiers = findFrontiers(grid);
+  ASSERT_EQ(frontiers.frontiers.size(), 1u);
+  EXPECT_FALSE(nearestFrontierGoal(frontiers, planner, Blacklist(), FrontierOptions()).has_value());
+  // From the other side it is reachable.
+  ASSERT_TRUE(planner.computeCostsFrom(Point2(8.0, 2.0)));
+  EXPECT_TRUE(nearestFrontierGoal(frontiers, planner, Blacklist(), FrontierOptions()).has_value());
+}
+
+TEST(Frontier, GoalsKeepRobotRadiusButPathsPassNarrowDoors) {
+  // Known room x = 0.2..4.0 with a wall at x = 4.0..4.2 and a 0.6 m door in it (6 free cells: its centre is 0.3 m
+  // from the jambs); behind the door 1 m of known floor, then unknown space (a frontier at x = 5.15).
+  OccupancyGrid grid = unknownGrid(100, 40);
+  grid.cells(cv::Rect(2, 0, 50, 40)).setTo(OccupancyGrid::kOccupied);
+  grid.cells(cv::Rect(3, 1, 37, 38)).setTo(OccupancyGrid::kFree);
+  grid.cells(cv::Rect(40, 17, 2, 6)).setTo(OccupancyGrid::kFree);  // the door, rows 17..22
+  grid.cells(cv::Rect(42, 1, 10, 38)).setTo(OccupancyGrid::kFree);  // behind it, up to the frontier
+  const FrontierMap frontiers = findFrontiers(grid);
+  ASSERT_EQ(frontiers.frontiers.size(), 1u);
+
+  GridPlannerOptions planner_options;
+  planner_options.robot_radius = 0.38;
+  planner_options.min_clearance = 0.25;
+  GridPlanner planner(planner_options);
+  planner.setMap(grid);
+  ASSERT_TRUE(planner.computeCostsFrom(Point2(2.0, 2.0)));
+  const std::optional<FrontierGoal> goal = nearestFrontierGoal(frontiers, planner, Blacklist(), FrontierOptions());
+  ASSERT_TRUE(goal.has_value());
+  EXPECT_GT(goal->position.x(), 4.2);  // through the door
+  EXPECT_NE(planner.roomy()(goal->cell.y, goal->cell.x), 0);
+
+  // With the inflation at robot_radius the door is closed and the frontier unreachable.
+  planner_options.min_clearance = planner_options.robot_radius;
+  GridPlanner strict(planner_options);
+  strict.setMap(grid);
+  ASSERT_TRUE(strict.computeCostsFrom(Point2(2.0, 2.0)));
+  EXPECT_FALSE(nearestFrontierGoal(frontiers, strict, Blacklist(), FrontierOptions()).has_value());
+
+  // A frontier in the door (the floor beyond it unknown): the cells within goal_reach (0.3 m here) of it are in
+  // the door's narrow band, traversable and reachable but not roomy, so no goal there.
+  grid.cells(cv::Rect(42, 0, 10, 39)).setTo(OccupancyGrid::kUnknown);
+  planner_options.min_clearance = 0.25;
+  GridPlanner narrow(planner_options);
+  narrow.setMap(grid);
+  ASSERT_TRUE(narrow.computeCostsFrom(Point2(2.0, 2.0)));
+  FrontierOptions door_options;
+  door_options.min_frontier_cells = 4;  // the door's 6 cells
+  door_options.goal_reach = 0.3;
+  const FrontierMap door_frontier = findFrontiers(grid, door_options);
+  ASSERT_EQ(door_frontier.frontiers.size(), 1u);
+  EXPECT_EQ(door_frontier.frontiers[0].cells.front().x, 41);
+  EXPECT_TRUE(std::isfinite(narrow.costTo(40, 19)));  // in the door: reachable ...
+  EXPECT_EQ(narrow.roomy()(19, 40), 0);                // ... but not roomy
+  EXPECT_FALSE(nearestFrontierGoal(door_frontier, narrow, Blacklist(), door_options).has_value());
+  door_options.goal_reach = 0.6;  // roomy cells of the room within reach: a goal before the door
+  const std::optional<FrontierGoal> before_door = nearestFrontierGoal(door_frontier, narrow, Blacklist(), door_options);
+  ASSERT_TRUE(before_door.has_value());
+  EXPECT_LT(before_door->position.x(), 3.9);
+}
+
+}  // namespace
+}  // namespace hidden_rooms

@@ -1,0 +1,175 @@
+// RbpfMapper (MRPT's RBPF) on scans of the core simulation: map quality against the rendered ground truth,
+// trajectory error, determinism per seed, bad ini files.
+#include <cmath>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "hidden_rooms/common/input_error.h"
+#include "hidden_rooms/evaluation/map_quality.h"
+#include "hidden_rooms/mapping/rbpf_mapper.h"
+#include "hidden_rooms/simulation/simulation.h"
+#include "hidden_rooms/simulation/wander_driver.h"
+#include "hidden_rooms/world/environment.h"
+#include "hidden_rooms/world/render.h"
+#include "test_util.h"
+
+namespace hidden_rooms {
+namespace {
+
+const std::string kConfig = std::string(HIDDEN_ROOMS_SOURCE_DIR) + "/config/rbpf.ini";
+
+struct MappingRun {
+  OccupancyGrid map;
+  MapQuality quality;
+  TrajectoryError trajectory;
+  int scans = 0;
+  int inserted = 0;
+  std::vector<RbpfParticle> particles;
+};
+
+// Drives the robot (wander) through a world for `seconds` and maps it with scans at 10 Hz.
+MappingRun mapWorld(const std::string& world_file, double seconds, uint32_t mapper_seed) {
+  const Environment environment = loadEnvironment(world_file);
+  const RenderedEnvironment truth = renderEnvironment(environment, {});
+  SimulationOptions options;
+  options.seed = 3;
+  Simulation simulation(worldFromEnvironment(environment, {}), options);
+  RbpfMapperOptions mapper_options;
+  mapper_options.config_file = kConfig;
+  mapper_options.seed = mapper_seed;
+  RbpfMapper mapper(mapper_options);
+  WanderDriver driver;
+
+  RangeScan scan;
+  const LaserGeometry& laser = simulation.laserGeometry();
+  scan.angle_min = laser.angle_min;
+  scan.angle_increment = laser.angle_increment;
+  scan.range_min = options.laser.min_range;
+  scan.range_max = laser.max_range;
+  scan.sensor_pose = options.laser.mount;
+  std::vector<Pose2> estimate, true_poses;
+  cv::Mat1b observed;
+  MappingRun run;
+  const int steps = static_cast<int>(std::lround(seconds / options.physics_step));
+  for (int k = 1; k <= steps; ++k) {
+    simulation.step();
+    if (k % 10 != 0) continue;
+    simulation.scan(&scan.ranges);
+    simulation.setCommand(driver.next(scan.ranges, laser));
+    if (mapper.addScan(simulation.odometryPose(), scan))
+      markObservedCells(truth.map, simulation.laserPose(), scan, &observed);
+    estimate.push_back(mapper.pose());
+    true_poses.push_back(simulation.truePose());
+    ++run.scans;
+  }
+  const Pose2 world_from_map = composePoses(simulation.truePose(), invertPose(mapper.pose()));
+  run.map = mapper.map();
+  run.quality = evaluateMap(run.map, world_from_map, truth.map, observed);
+  run.trajectory = trajectoryError(estimate, true_poses, world_from_map);
+  run.inserted = mapper.scansInserted();
+  run.particles = mapper.particles();
+  return run;
+}
+
+TEST(RbpfMapper, MapsASmallWorldCloseToTheGroundTruth) {
+  const MappingRun run = mapWorld(std::string(HIDDEN_ROOMS_SOURCE_DIR) + "/worlds/small_1.xml", 90.0, 1);
+  std::printf("scans %d inserted %d free IoU %.3f (true %lld, map %lld) walls within 2 cells %.3f mean %.2f p95 %.2f "
+              "RMSE %.3f m yaw %.3f rad max %.3f m\n",
+              run.scans, run.inserted, run.quality.free_iou, run.quality.true_free_cells, run.quality.map_free_cells,
+              run.quality.walls_within_2_cells, run.quality.wall_distance_mean, run.quality.wall_distance_p95,
+              run.trajectory.position_rmse, run.trajectory.yaw_rmse, run.trajectory.position_max);
+  EXPECT_GT(run.inserted, 20);
+  EXPECT_GE(run.quality.free_iou, 0.85);
+  EXPECT_GE(run.quality.walls_within_2_cells, 0.85);
+  EXPECT_LT(run.trajectory.position_rmse, 0.25);
+  double weights = 0.0;
+  for (const RbpfParticle& p : run.particles) weights += p.weight;
+  EXPECT_EQ(run.particles.size(), 8u);
+  EXPECT_NEAR(weights, 1.0, 1e-9);
+  EXPECT_NEAR(run.map.resolution, 0.05, 1e-6);
+}
+
+TEST(RbpfMapper, SameScansAndSeedGiveTheSameMap) {
+  const std::string world = std::string(HIDDEN_ROOMS_SOURCE_DIR) + "/worlds/small_2.xml";
+  const MappingRun a = mapWorld(world, 25.0, 7), b = mapWorld(world, 25.0, 7);
+  ASSERT_EQ(a.map.cells.size(), b.map.cells.size());
+  EXPECT_EQ(cv::countNonZero(a.map.cells != b.map.cells), 0);
+  EXPECT_EQ(a.map.origin, b.map.origin);
+}
+
+TEST(RbpfMapper, StartsAtTheFirstOdometryPose) {
+  RbpfMapperOptions options;
+  options.config_file = kConfig;
+  RbpfMapper mapper(options);
+  EXPECT_TRUE(mapper.map().empty());
+  RangeScan scan;
+  scan.angle_min = -1.0;
+  scan.angle_increment = 0.01;
+  scan.range_min = 0.05;
+  scan.range_max = 10.0;
+  scan.ranges.assign(201, 2.0f);
+  EXPECT_TRUE(mapper.addScan({1.0, 2.0, 0.5}, scan));
+  const Pose2 pose = mapper.pose(), map_to_odom = mapper.mapToOdom();
+  // The filter's first step draws the particles around the start (the motion model's minimum noise).
+  EXPECT_NEAR(pose.x, 1.0, 0.02);
+  EXPECT_NEAR(pose.y, 2.0, 0.02);
+  EXPECT_NEAR(pose.yaw, 0.5, 0.02);
+  EXPECT_NEAR(map_to_odom.x, 0.0, 0.02);
+  EXPECT_NEAR(map_to_odom.yaw, 0.0, 0.02);
+  const OccupancyGrid map = mapper.map();
+  ASSERT_FALSE(map.empty());
+  int col = 0, row = 0;
+  ASSERT_TRUE(map.cellOf(Point2(1.0 + 1.0 * std::cos(0.5), 2.0 + 1.0 * std::sin(0.5)), &col, &row));
+  EXPECT_GE(map.cells(row, col), 0);
+  EXPECT_LT(map.cells(row, col), 50) << "free in front of the robot";
+  ASSERT_TRUE(map.cellOf(Point2(1.0 + 2.0 * std::cos(0.5), 2.0 + 2.0 * std::sin(0.5)), &col, &row));
+  EXPECT_GT(map.cells(row, col), 50) << "the hit";
+  ASSERT_TRUE(map.cellOf(Point2(1.0 - 1.0 * std::cos(0.5), 2.0 - 1.0 * std::sin(0.5)), &col, &row));
+  EXPECT_EQ(map.cells(row, col), OccupancyGrid::kUnknown) << "behind the robot, outside the scan";
+  EXPECT_THROW(mapper.addScan({0.0, 0.0, 0.0}, RangeScan()), InputError);
+}
+
+TEST(RbpfMapper, RejectsBadIniFiles) {
+  const std::string dir = testing::makeTempDir("rbpf_ini");
+  RbpfMapperOptions options;
+  options.config_file = dir + "/missing.ini";
+  EXPECT_THROW({ RbpfMapper mapper(options); }, InputError);
+  options.config_file = dir + "/garbage.ini";
+  std::ofstream(options.config_file) << "this is not [an ini\n\x01\x02 = =\n";
+  try {
+    RbpfMapper mapper(options);
+    ADD_FAILURE() << "garbage accepted";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("garbage.ini"), std::string::npos) << error.what();
+  }
+  // A valid ini without the grid.
+  std::ifstream in(kConfig);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const size_t at = text.find("occupancyGrid_count = 1");
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, 23, "occupancyGrid_count = 0");
+  options.config_file = dir + "/nogrid.ini";
+  std::ofstream(options.config_file) << text;
+  EXPECT_THROW({ RbpfMapper mapper(options); }, InputError);
+
+  // A published map's certainty outside (0.5, 1).
+  text.replace(at, 23, "occupancyGrid_count = 1");
+  const std::string freeness = "maxFreenessUpdateCertainty  = 0.70";
+  const size_t freeness_at = text.find(freeness);
+  ASSERT_NE(freeness_at, std::string::npos);
+  text.replace(freeness_at, freeness.size(), "maxFreenessUpdateCertainty  = 1.5");
+  options.config_file = dir + "/published.ini";
+  std::ofstream(options.config_file) << text;
+  try {
+    RbpfMapper mapper(options);
+    ADD_FAILURE() << "certainty 1.5 accepted";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("PublishedMap"), std::string::npos) << error.what();
+  }
+}
+
+}  // namespace
+}  // namespace hidden_rooms

@@ -1,0 +1,328 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "hidden_rooms/common/input_error.h"
+#include "hidden_rooms/common/occupancy_grid.h"
+#include "hidden_rooms/evaluation/evaluation.h"
+#include "hidden_rooms/prediction/default_predictor.h"
+#include "hidden_rooms/prediction/prediction_support.h"
+#include "hidden_rooms/prediction/room_predictor.h"
+#include "test_util.h"
+
+namespace hidden_rooms {
+namespace {
+
+// A synthetic floor: a corridor with three adjacent hidden rooms above it (their shared walls unseen; a known
+// service corridor beyond them) and, below it, an explored room, a hidden room and an explored room.
+// Drawn in pixels (0 unknown, 1 free, 2 wall), optionally rotated by `degrees` about the image centre.
+struct Synthetic {
+  PredictionRequest request;
+  cv::Mat1w truth;
+};
+
+Synthetic syntheticFloor(double degrees) {
+  const cv::Size size(420, 300);
+  cv::Mat1b states(size, 0);
+  cv::Mat1w labels(size, 0);
+  auto fill = [&](cv::Mat& image, const cv::Rect& r, int value) { image(r).setTo(value); };
+  // Walls first, free space on top.
+  fill(states, cv::Rect(37, 2, 326, 18), 2);     // around the service corridor
+  fill(states, cv::Rect(37, 97, 326, 166), 2);   // around the corridor and the lower rooms
+  fill(states, cv::Rect(40, 5, 320, 12), 1);     // service corridor
+  fill(states, cv::Rect(40, 100, 320, 40), 1);   // main corridor
+  fill(states, cv::Rect(40, 143, 100, 117), 1);  // explored room below, left
+  fill(states, cv::Rect(246, 143, 114, 117), 1); // explored room below, right
+  // Hidden rooms (unknown in the map), their true extents.
+  const std::vector<cv::Rect> hidden{cv::Rect(40, 20, 100, 77), cv::Rect(143, 20, 100, 77),
+                                     cv::Rect(246, 20, 114, 77), cv::Rect(143, 143, 100, 117)};
+  for (size_t k = 0; k < hidden.size(); ++k) fill(labels, hidden[k], static_cast<int>(k + 1));
+  fill(states, hidden[3], 0);
+  // The walls between the hidden rooms above were never seen: unknown.
+  fill(states, cv::Rect(140, 20, 3, 77), 0);
+  fill(states, cv::Rect(243, 20, 3, 77), 0);
+  // Door centres (pixels, on the wall rows) and orientations.
+  std::vector<cv::Point2d> doors{{90, 98.5}, {193, 98.5}, {303, 98.5}, {193, 141.5}};
+
+  cv::Mat1b rotated_states = states;
+  cv::Mat1w rotated_labels = labels;
+  if (degrees != 0.0) {
+    const cv::Mat m = cv::getRotationMatrix2D(cv::Point2f(size.width / 2.0f, size.height / 2.0f), degrees, 1.0);
+    cv::warpAffine(states, rotated_states, m, size, cv::INTER_NEAREST, cv::BORDER_CONSTANT, cv::Scalar(0));
+    cv::warpAffine(labels, rotated_labels, m, size, cv::INTER_NEAREST, cv::BORDER_CONSTANT, cv::Scalar(0));
+    const cv::Matx23d a(m);
+    for (cv::Point2d& p : doors)
+      p = cv::Point2d(a(0, 0) * p.x + a(0, 1) * p.y + a(0, 2), a(1, 0) * p.x + a(1, 1) * p.y + a(1, 2));
+  }
+  Synthetic result;
+  OccupancyGrid& map = result.request.map;
+  map.resolution = 0.05;
+  map.cells = cv::Mat_<int8_t>(size, OccupancyGrid::kUnknown);
+  for (int r = 0; r < size.height; ++r)
+    for (int c = 0; c < size.width; ++c) {
+      if (rotated_states(r, c) == 1) map.cells(r, c) = OccupancyGrid::kFree;
+      if (rotated_states(r, c) == 2) map.cells(r, c) = OccupancyGrid::kOccupied;
+    }
+  rotated_labels.setTo(0, map.cells != OccupancyGrid::kUnknown);
+  result.truth = rotated_labels;
+  for (size_t k = 0; k < doors.size(); ++k) {
+    MapDoor door;
+    door.id = static_cast<int>(k + 1);
+    door.width = 1.0;
+    door.orientation = DoorOrientation::kAlongX;
+    // Image point (column, row) -> map frame (y up, origin at the lower-left corner).
+    door.position = Point2(doors[k].x * map.resolution, (size.height - doors[k].y) * map.resolution);
+    result.request.doors.doors.push_back(door);
+  }
+  return result;
+}
+
+RoomScores scoreOf(const Synthetic& s, const PredictionResult& result) {
+  return scoreRooms(roomLabels(s.request.map, s.request.doors, result.rooms), s.truth,
+                    static_cast<int>(s.request.doors.doors.size()));
+}
+
+TEST(DefaultPredictor, RecoversAdjacentRoomsBehindClosedDoors) {
+  const Synthetic s = syntheticFloor(0.0);
+  const PredictionResult result = makeRoomPredictor("default")->predict(s.request);
+  ASSERT_EQ(result.rooms.size(), 4u);
+  const RoomScores scores = scoreOf(s, result);
+  for (size_t k = 0; k < scores.iou.size(); ++k) EXPECT_GT(scores.iou[k], 0.9) << "door " << k + 1;
+}
+
+TEST(DefaultPredictor, RecoversRoomsOfARotatedMap) {
+  const Synthetic s = syntheticFloor(20.0);
+  EXPECT_NEAR(std::abs(dominantWallAngle(s.request.map)) * 180.0 / CV_PI, 20.0, 1.5);
+  const PredictionResult result = makeRoomPredictor("default")->predict(s.request);
+  const RoomScores scores = scoreOf(s, result);
+  EXPECT_GT(scores.mean_iou, 0.8);
+  for (size_t k = 0; k < scores.iou.size(); ++k) EXPECT_GT(scores.iou[k], 0.7) << "door " << k + 1;
+}
+
+TEST(DefaultPredictor, MeasuresDepthBehindARaggedWall) {
+  // A SLAM map's wall, turned back by the dominant angle, is ragged: away from the door its pixels reach a row
+  // or two past the door's first unknown row (here row 96 at door 1, in 3 of 4 columns). The depth is measured
+  // behind them, not stopped on them.
+  Synthetic s = syntheticFloor(0.0);
+  for (int col = 40; col < 140; ++col)
+    if ((col < 78 || col > 102) && col % 4 != 0) s.request.map.cells(96, col) = OccupancyGrid::kOccupied;
+  s.truth.setTo(0, s.request.map.cells != OccupancyGrid::kUnknown);
+  s.request.parameters = {{"default_grown_area_ratio", 1e9}};  // the rectangles only
+  const PredictionResult result = makeRoomPredictor("default")->predict(s.request);
+  EXPECT_NEAR(result.rooms[0].terms.at("depth"), 76 * 0.05, 0.1);
+  EXPECT_GT(scoreOf(s, result).iou[0], 0.8);
+}
+
+TEST(DefaultPredictor, IsDeterministic) {
+  const Synthetic s = syntheticFloor(7.0);
+  const auto predictor = makeRoomPredictor("default");
+  const PredictionResult a = predictor->predict(s.request), b = predictor->predict(s.request);
+  ASSERT_EQ(a.rooms.size(), b.rooms.size());
+  for (size_t k = 0; k < a.rooms.size(); ++k) EXPECT_EQ(cv::countNonZero(a.rooms[k].mask != b.rooms[k].mask), 0);
+}
+
+TEST(DefaultPredictor, ReportsADoorOutsideTheMapAndPredictsTheOthers) {
+  Synthetic s = syntheticFloor(0.0);
+  MapDoor outside;
+  outside.id = 9;
+  outside.position = Point2(-20.0, -20.0);
+  s.request.doors.doors.push_back(outside);
+  const PredictionResult result = makeRoomPredictor("default")->predict(s.request);
+  ASSERT_EQ(result.rooms.size(), 5u);
+  EXPECT_FALSE(result.rooms[4].placed);
+  EXPECT_EQ(result.rooms[4].door_id, 9);
+  EXPECT_FALSE(result.rooms[4].problem.empty());
+  for (size_t k = 0; k < 4; ++k) EXPECT_TRUE(result.rooms[k].placed) << result.rooms[k].problem;
+}
+
+TEST(DefaultPredictor, NeverPredictsKnownCells) {
+  for (double degrees : {0.0, 20.0}) {
+    const Synthetic s = syntheticFloor(degrees);
+    const PredictionResult result = makeRoomPredictor("default")->predict(s.request);
+    for (const RoomPrediction& room : result.rooms) {
+      EXPECT_EQ(cv::countNonZero(room.mask & (s.request.map.cells != OccupancyGrid::kUnknown)), 0);
+      EXPECT_NEAR(room.area, cv::countNonZero(room.mask) * 0.0025, 1e-9);
+    }
+  }
+}
+
+TEST(DefaultPredictor, RejectsBadParameters) {
+  const Synthetic s = syntheticFloor(0.0);
+  PredictionRequest request = s.request;
+  request.parameters["default_bounded_fraction"] = 2.0;
+  EXPECT_THROW(makeRoomPredictor("default")->predict(request), InputError);
+}
+
+// Two hidden rooms above a corridor, their shared wall unseen; a pillar in the corridor marks where that wall
+// meets the corridor's wall, and the doors sit off-centre, so that cutting between the doors misplaces the wall.
+Synthetic corridorWithPillar() {
+  const cv::Size size(300, 160);
+  cv::Mat1b states(size, 0);
+  states(cv::Rect(17, 2, 266, 18)).setTo(2);   // around the service corridor above the rooms
+  states(cv::Rect(17, 97, 266, 46)).setTo(2);  // around the main corridor
+  states(cv::Rect(20, 5, 260, 12)).setTo(1);
+  states(cv::Rect(20, 100, 260, 40)).setTo(1);
+  states(cv::Rect(148, 100, 7, 10)).setTo(2);  // the pillar, 0.5 m into the corridor
+  Synthetic result;
+  result.truth = cv::Mat1w::zeros(size);
+  result.truth(cv::Rect(20, 20, 130, 77)).setTo(1);
+  result.truth(cv::Rect(153, 20, 127, 77)).setTo(2);
+  OccupancyGrid& map = result.request.map;
+  map.resolution = 0.05;
+  map.cells = cv::Mat_<int8_t>(size, OccupancyGrid::kUnknown);
+  map.cells.setTo(OccupancyGrid::kFree, states == 1);
+  map.cells.setTo(OccupancyGrid::kOccupied, states == 2);
+  for (const auto& [id, column] : {std::pair<int, double>{1, 40.0}, {2, 175.0}}) {
+    MapDoor door;
+    door.id = id;
+    door.width = 1.0;
+    door.orientation = DoorOrientation::kAlongX;
+    door.position = Point2(column * map.resolution, (size.height - 98.5) * map.resolution);
+    result.request.doors.doors.push_back(door);
+  }
+  return result;
+}
+
+TEST(DefaultPredictor, WallStubsEndTheRoomsAlongTheirWall) {
+  Synthetic s = corridorWithPillar();
+  s.request.parameters["default_grown_area_ratio"] = 1000.0;  // the wall-fitted rectangles only
+  const RoomScores with_stubs = scoreOf(s, makeRoomPredictor("default")->predict(s.request));
+  for (size_t k = 0; k < with_stubs.iou.size(); ++k) EXPECT_GT(with_stubs.iou[k], 0.9) << "door " << k + 1;
+  s.request.parameters["default_stub_length"] = 0.0;  // stubs ignored: cut halfway between the doors
+  EXPECT_LT(scoreOf(s, makeRoomPredictor("default")->predict(s.request)).iou[0], 0.8);
+}
+
+// A map drawn from a state image (0 unknown, 1 free, 2 wall) with doors on horizontal walls (image column, row).
+Synthetic syntheticFromStates(const cv::Mat1b& states, const cv::Mat1w& truth,
+                              const std::vector<cv::Point2d>& doors) {
+  Synthetic result;
+  result.truth = truth;
+  OccupancyGrid& map = result.request.map;
+  map.resolution = 0.05;
+  map.cells = cv::Mat_<int8_t>(states.size(), OccupancyGrid::kUnknown);
+  map.cells.setTo(OccupancyGrid::kFree, states == 1);
+  map.cells.setTo(OccupancyGrid::kOccupied, states == 2);
+  for (size_t k = 0; k < doors.size(); ++k) {
+    MapDoor door;
+    door.id = static_cast<int>(k + 1);
+    door.width = 1.0;
+    door.orientation = DoorOrientation::kAlongX;
+    door.position = Point2(doors[k].x * map.resolution, (states.rows - doors[k].y) * map.resolution);
+    result.request.doors.doors.push_back(door);
+  }
+  return result;
+}
+
+// A hidden room above a corridor whose door sits at the back of a shallow niche: the niche's side walls run
+// from the door's line to the corridor's wall, which is not a pillar standing free; the room spans the wall.
+TEST(DefaultPredictor, NicheSideWallsAreNotStubs) {
+  const cv::Size size(240, 160);
+  cv::Mat1b states(size, 0);
+  states(cv::Rect(17, 95, 206, 48)).setTo(2);   // around the corridor
+  states(cv::Rect(20, 99, 200, 40)).setTo(1);   // corridor
+  states(cv::Rect(17, 2, 206, 18)).setTo(2);    // around a service corridor above the room
+  states(cv::Rect(20, 5, 200, 12)).setTo(1);
+  states(cv::Rect(97, 89, 26, 10)).setTo(2);    // the niche's walls and the door's line
+  states(cv::Rect(100, 92, 20, 7)).setTo(1);    // the niche
+  cv::Mat1w truth = cv::Mat1w::zeros(size);
+  truth(cv::Rect(20, 20, 200, 75)).setTo(1);
+  truth.setTo(0, states != 0);
+  Synthetic s = syntheticFromStates(states, truth, {{110, 90}});
+  s.request.parameters["default_grown_area_ratio"] = 1000.0;  // the wall-fitted rectangle only
+  EXPECT_GT(scoreOf(s, makeRoomPredictor("default")->predict(s.request)).iou[0], 0.9);
+}
+
+// A block of unknown between a north corridor and a west corridor, bounded by known space to the south and
+// east: a room behind a door in the north corridor, and below it a long room behind a door in the west corridor
+// (their shared wall unseen). Stubs in the corridors mark where the rooms' walls meet the corridors. Both
+// rectangles reach across the whole block; the overlap belongs to the west door, which opens right into it.
+TEST(DefaultPredictor, OverlapOfPerpendicularDoorsGoesToTheNearerDoor) {
+  const cv::Size size(260, 260);
+  cv::Mat1b states(size, 2);
+  states(cv::Rect(5, 5, 250, 40)).setTo(1);     // north corridor, rows 5..44
+  states(cv::Rect(5, 5, 40, 250)).setTo(1);     // west corridor, columns 5..44
+  states(cv::Rect(48, 48, 172, 172)).setTo(0);  // the unknown block, rows and columns 48..219
+  states(cv::Rect(48, 223, 207, 32)).setTo(1);  // explored space south of the block
+  states(cv::Rect(223, 48, 32, 207)).setTo(1);  // and east of it
+  states(cv::Rect(110, 37, 6, 8)).setTo(2);     // stub in the north corridor at the rooms' west wall
+  states(cv::Rect(37, 130, 8, 6)).setTo(2);     // stub in the west corridor at the rooms' shared wall
+  cv::Mat1w truth = cv::Mat1w::zeros(size);
+  truth(cv::Rect(113, 48, 107, 85)).setTo(1);   // behind the north door: rows 48..132
+  truth(cv::Rect(48, 133, 172, 87)).setTo(2);   // behind the west door: rows 133..219, the block's width
+  Synthetic s = syntheticFromStates(states, truth, {{165, 46}, {46, 190}});
+  s.request.doors.doors[1].orientation = DoorOrientation::kAlongY;
+  s.request.parameters["default_grown_area_ratio"] = 1000.0;  // the wall-fitted rectangles only
+  const RoomScores scores = scoreOf(s, makeRoomPredictor("default")->predict(s.request));
+  for (size_t k = 0; k < scores.iou.size(); ++k) EXPECT_GT(scores.iou[k], 0.9) << "door " << k + 1;
+}
+
+// Rooms side by side along a corridor, walls 8 pixels (0.4 m) thick. Seen from both sides (the free corridor and
+// free rooms) they cross 8 pixels; a room behind a closed door shows only its corridor wall's near face (2 pixels)
+// and the rest is unknown: 6 pixels (0.3 m) unseen. A map that draws whole walls shows none unseen.
+TEST(DefaultPredictor, EstimatesTheUnseenWallThickness) {
+  const auto floor = [](int shown) {
+    cv::Mat1b states(120, 400, static_cast<uint8_t>(2));
+    states(cv::Rect(8, 80, 384, 32)).setTo(1);                   // the corridor
+    for (int x = 8; x + 40 <= 392; x += 48) states(cv::Rect(x, 8, 40, 64)).setTo(1);  // rooms, 8 px walls
+    // The middle rooms are hidden: unknown behind the near `shown` rows of their corridor wall.
+    for (int x : {152, 200}) states(cv::Rect(x, 8, 40, 64 + 8 - shown)).setTo(0);
+    return syntheticFromStates(states, cv::Mat1w::zeros(states.size()), {});
+  };
+  EXPECT_NEAR(unseenWallThickness(floor(2).request.map), 0.30, 1e-9);
+  EXPECT_NEAR(unseenWallThickness(floor(8).request.map), 0.0, 1e-9);
+}
+
+// The margin keeps the unseen part of the door's wall out of the room: with the walls of a hidden room shown only
+// by their near faces, the room ends a wall's thickness from them.
+TEST(DefaultPredictor, LeavesTheUnseenWallsOutOfTheRooms) {
+  cv::Mat1b states(120, 400, static_cast<uint8_t>(2));
+  states(cv::Rect(8, 80, 384, 32)).setTo(1);
+  for (int x = 8; x + 40 <= 392; x += 48) states(cv::Rect(x, 8, 40, 64)).setTo(1);
+  states(cv::Rect(144, 0, 56, 78)).setTo(0);  // a hidden room (x 152..191, y 8..71) and its walls, but the near
+  cv::Mat1w truth = cv::Mat1w::zeros(states.size());  // 2 rows of the corridor wall, unknown
+  truth(cv::Rect(152, 8, 40, 64)).setTo(1);
+  Synthetic s = syntheticFromStates(states, truth, {{172, 77}});
+  const PredictionResult result = makeRoomPredictor("default")->predict(s.request);
+  ASSERT_EQ(result.rooms.size(), 1u);
+  EXPECT_NEAR(result.rooms[0].terms.at("wall_margin"), 0.30, 1e-9);
+  const double with_margin = scoreOf(s, result).iou[0];
+  s.request.parameters["default_wall_margin"] = 0.0;
+  const double without = scoreOf(s, makeRoomPredictor("default")->predict(s.request)).iou[0];
+  std::printf("IoU with the estimated margin %.3f, without %.3f\n", with_margin, without);
+  EXPECT_GT(with_margin, 0.7);
+  EXPECT_GT(with_margin, without + 0.05);
+}
+
+TEST(DefaultPredictor, ClipsRoomsToTheKnownOutlineBesideThem) {
+  cv::Mat1b known = cv::Mat1b::zeros(100, 100);
+  known(cv::Rect(60, 20, 30, 60)).setTo(255);  // an explored room beside the hidden one, rows 20..79
+  known(cv::Rect(0, 80, 100, 10)).setTo(255);  // the corridor below both
+  cv::Mat1b room = cv::Mat1b::zeros(100, 100);
+  room(cv::Rect(10, 0, 40, 80)).setTo(255);    // a hidden room predicted up to the image's edge
+  clipToKnownOutline(known, cv::Point(30, 80), 20, 10, &room);
+  EXPECT_EQ(cv::boundingRect(room), cv::Rect(10, 20, 40, 60));
+  // Nothing known beyond the door on that side: no limit.
+  cv::Mat1b alone = cv::Mat1b::zeros(100, 100);
+  alone(cv::Rect(10, 0, 40, 80)).setTo(255);
+  cv::Mat1b corridor_only = cv::Mat1b::zeros(100, 100);
+  corridor_only(cv::Rect(0, 80, 100, 10)).setTo(255);
+  clipToKnownOutline(corridor_only, cv::Point(30, 80), 20, 10, &alone);
+  EXPECT_EQ(cv::boundingRect(alone), cv::Rect(10, 0, 40, 80));
+}
+
+// Mean IoU of `default` over the benchmark's 44 valid cases; the floor sits a little under the measured mean
+// (0.724), so that a regression fails.
+TEST(DefaultPredictor, KeepsItsAccuracyOnTheBenchmark) {
+  HIDDEN_ROOMS_REQUIRE_SHARED_DATA();
+  int cases = 0;
+  EXPECT_GE(testing::benchmarkMeanIou("default", &cases), 0.71);
+  EXPECT_EQ(cases, 44);
+}
+
+}  // namespace
+}  // namespace hidden_rooms

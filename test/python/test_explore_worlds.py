@@ -1,0 +1,145 @@
+#!/usr/bin/python3
+"""scripts/explore_worlds end to end on test/data/simulator_corridor.xml (a corridor with two rooms) with door 1
+closed: its own ROS master, simulator + mapper + explorer + pose_logger until the explorer is done, then the
+saved map, the door translated into the map frame, the true room, the prediction and the summary; bad input; and
+the no_growth rule.
+
+Needs the built package (found like the scripts find it: $CMAKE_PREFIX_PATH, else the checkout's .ws) and
+roslaunch; skips without them, unless HIDDEN_ROOMS_REQUIRE_SHARED=1 (scripts/test.sh), when it fails.
+"""
+import csv
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+import unittest
+
+import yaml
+
+PACKAGE_DIR = os.path.dirname(os.path.dirname(os.path.dirname(os.path.realpath(__file__))))
+sys.path.insert(0, os.path.join(PACKAGE_DIR, "src"))
+from hidden_rooms import package_tools  # noqa: E402
+from hidden_rooms.explore_worlds import GrowthStop  # noqa: E402
+
+SCRIPT = os.path.join(PACKAGE_DIR, "scripts", "explore_worlds")
+WORLD = os.path.join(PACKAGE_DIR, "test", "data", "simulator_corridor.xml")
+# A map saved every 10 s of simulated time (the corridor takes 25-45 s); a negative growth never ends the run early.
+RUN_OPTIONS = ["--closed", "1", "--timeout", "10", "--growth", "-1", "--max-time", "300"]
+
+
+def run(*arguments, timeout=600):
+    return subprocess.run([sys.executable, SCRIPT] + list(arguments), capture_output=True, text=True, timeout=timeout)
+
+
+class GrowthStopTest(unittest.TestCase):
+    def test_stops_after_patience_maps_in_a_row_without_growth(self):
+        stop = GrowthStop(0.01, 2)
+        # 1000 -> 1005 (+0.5 %: flat) -> 1100 (grew: the count starts again) -> 1100 -> 1099: stop.
+        self.assertEqual([stop.update(free) for free in (1000, 1005, 1100, 1100, 1099)],
+                         [False, False, False, False, True])
+        thesis = GrowthStop(0.01, 1)
+        self.assertEqual([thesis.update(free) for free in (1000, 1005)], [False, True])
+        never = GrowthStop(-1, 1)
+        self.assertFalse(any(never.update(free) for free in (1000, 900, 0, 0)))
+
+
+class ExploreWorldsTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        try:
+            package_tools.find_binary("translate_doors")
+            package_tools.find_binary("explorer")
+        except package_tools.ToolError as error:
+            if os.environ.get("HIDDEN_ROOMS_REQUIRE_SHARED") == "1":
+                raise AssertionError("package not built: %s" % error)
+            raise unittest.SkipTest(str(error))
+        cls.out = tempfile.mkdtemp(prefix="hidden_rooms_explore_worlds_")
+        cls.result = run(WORLD, "--out", cls.out, *RUN_OPTIONS)
+
+    @classmethod
+    def tearDownClass(cls):
+        shutil.rmtree(cls.out, ignore_errors=True)
+
+    def test_explores_to_completion_and_predicts_the_hidden_room(self):
+        self.assertEqual(self.result.returncode, 0, self.result.stdout + self.result.stderr)
+        with open(os.path.join(self.out, "summary.csv")) as summary_file:
+            rows = list(csv.DictReader(summary_file))
+        self.assertEqual(len(rows), 1)
+        row = rows[0]
+        self.assertEqual(row["status"], "done", row)
+        # The pipeline's check; the explorer's own rostest holds it to 95 %.
+        self.assertGreaterEqual(float(row["coverage"]), 0.9, row)
+        self.assertLess(float(row["worst_door_error_m"]), 0.3, row)
+        self.assertGreater(float(row["mean_iou"]), 0.7, row)
+        self.assertGreater(float(row["path_length_m"]), 5.0, row)
+        run_dir = os.path.join(self.out, "simulator_corridor")
+        for name in ("map.yaml", "map.pgm", "doors.yaml", "true_rooms.png", "exploration.yaml", "overlay.png",
+                     "poses_map.log", "poses_truth.log", "prediction/map.yaml", "prediction/metrics.yaml"):
+            self.assertTrue(os.path.isfile(os.path.join(run_dir, name)), name)
+        self.assertTrue(os.listdir(os.path.join(run_dir, "maps")), "no map saved at the timeouts")
+        with open(os.path.join(run_dir, "doors.yaml")) as doors_file:
+            doors = yaml.safe_load(doors_file)["doors"]
+        self.assertEqual([door["id"] for door in doors], [1])
+
+    def test_a_rerun_keeps_the_finished_world(self):
+        self.assertEqual(self.result.returncode, 0, self.result.stdout + self.result.stderr)
+        with open(os.path.join(self.out, "summary.csv")) as summary_file:
+            before = list(csv.DictReader(summary_file))
+        again = run(WORLD, "--out", self.out, *RUN_OPTIONS, timeout=60)
+        self.assertEqual(again.returncode, 0, again.stdout + again.stderr)
+        self.assertIn("kept from an earlier run", again.stdout)
+        with open(os.path.join(self.out, "summary.csv")) as summary_file:
+            after = list(csv.DictReader(summary_file))
+        self.assertEqual(len(after), 1)
+        self.assertEqual({k: v for k, v in before[0].items() if k != "message"},
+                         {k: v for k, v in after[0].items() if k != "message"})
+
+    def test_sigkill_leaves_no_process_and_a_rerun_finishes(self):
+        out = tempfile.mkdtemp(prefix="hidden_rooms_explore_worlds_kill_")
+        try:
+            arguments = [WORLD, "--out", out] + RUN_OPTIONS
+            started = subprocess.Popen([sys.executable, SCRIPT] + arguments, stdout=subprocess.DEVNULL,
+                                       stderr=subprocess.DEVNULL)
+            log_dir = os.path.join(out, "simulator_corridor")
+            deadline = time.monotonic() + 60
+            while time.monotonic() < deadline and not os.path.isfile(os.path.join(log_dir, "poses_map.log")):
+                time.sleep(0.5)
+            self.assertTrue(os.path.isfile(os.path.join(log_dir, "poses_map.log")), "the run did not start")
+            started.send_signal(signal.SIGKILL)
+            started.wait()
+            deadline = time.monotonic() + 30
+            while time.monotonic() < deadline and self.processes_of(out):
+                time.sleep(0.5)
+            self.assertEqual(self.processes_of(out), [], "processes left behind")
+            again = run(*arguments)
+            self.assertEqual(again.returncode, 0, again.stdout + again.stderr)
+            with open(os.path.join(out, "summary.csv")) as summary_file:
+                rows = list(csv.DictReader(summary_file))
+            self.assertEqual(len(rows), 1)
+            self.assertEqual(rows[0]["status"], "done", rows[0])
+        finally:
+            shutil.rmtree(out, ignore_errors=True)
+
+    @staticmethod
+    def processes_of(out):
+        """Command lines of running processes that name `out` (the worker, roslaunch and its nodes)."""
+        found = subprocess.run(["pgrep", "-af", out], capture_output=True, text=True).stdout
+        return [line for line in found.splitlines() if "pgrep" not in line]
+
+    def test_bad_input_exits_2_with_a_message(self):
+        missing = run(os.path.join(self.out, "no_such_world.xml"), "--out", self.out)
+        self.assertEqual(missing.returncode, 2)
+        self.assertIn("no_such_world.xml", missing.stderr)
+        jobs = run(WORLD, "--out", self.out, "--jobs", "0")
+        self.assertEqual(jobs.returncode, 2)
+        self.assertIn("--jobs", jobs.stderr)
+        bad_random = run(WORLD, "--out", os.path.join(self.out, "bad"), "--closed", "random:x")
+        self.assertEqual(bad_random.returncode, 2)
+        self.assertIn("random:N", bad_random.stderr)
+
+
+if __name__ == "__main__":
+    unittest.main()

@@ -1,0 +1,334 @@
+// rostest: room_predictor on a closed-door benchmark case answers predict_rooms with exactly the rooms of
+// predict_rooms_offline, publishes its overlays latched, answers bad requests with success = false and a clear
+// message, and keeps serving; predict_rooms_client saves the same files as the offline command.
+#include <gtest/gtest.h>
+#include <hidden_rooms/PredictRooms.h>
+#include <nav_msgs/OccupancyGrid.h>
+#include <ros/ros.h>
+#include <visualization_msgs/MarkerArray.h>
+#include <yaml-cpp/yaml.h>
+
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <set>
+#include <sstream>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "hidden_rooms/map3d/octomap_io.h"
+#include "hidden_rooms/prediction/prediction_support.h"
+#include "hidden_rooms/ros/conversions.h"
+#include "test_util.h"
+
+namespace {
+
+using hidden_rooms::PredictRooms;
+namespace testing_util = hidden_rooms::testing;
+
+std::string caseDir() {
+  std::string dir;
+  ros::NodeHandle("~").getParam("case", dir);
+  return dir;
+}
+
+// The node has the map once it has published its first prediction (~predict_on_map is on in the launch file).
+bool nodeHasTheMap() {
+  ros::NodeHandle nh;
+  return ros::topic::waitForMessage<nav_msgs::OccupancyGrid>("predicted_map", nh, ros::Duration(30.0)) != nullptr;
+}
+
+#define REQUIRE_CASE()                                                                                       \
+  do {                                                                                                       \
+    HIDDEN_ROOMS_REQUIRE_SHARED_DATA();                                                                      \
+    ASSERT_TRUE(std::filesystem::exists(caseDir() + "/map.yaml")) << "benchmark case missing: " << caseDir(); \
+    ASSERT_TRUE(nodeHasTheMap()) << "room_predictor published no prediction within 30 s";                    \
+  } while (0)
+
+bool call(PredictRooms* service, const std::string& name = "predict_rooms") {
+  if (!ros::service::waitForService(name, ros::Duration(30.0))) return false;
+  return ros::service::call(name, *service);
+}
+
+std::string readFile(const std::string& path) {
+  std::ifstream file(path, std::ios::binary);
+  std::stringstream text;
+  text << file.rdbuf();
+  return text.str();
+}
+
+// predict_rooms_offline on the case into a fresh folder.
+std::string runOffline(const std::string& method) {
+  const std::string out = testing_util::makeTempDir("room_predictor_offline_" + method);
+  const testing_util::CommandResult result =
+      testing_util::runCommand(std::string(PREDICT_ROOMS_OFFLINE_BIN) + " --map " + caseDir() + "/map.yaml --doors " +
+                               caseDir() + "/doors.yaml --method " + method + " --out " + out);
+  EXPECT_EQ(result.exit_code, 0) << result.output;
+  return out;
+}
+
+TEST(RoomPredictor, ServiceGivesTheOfflineCommandsRooms) {
+  REQUIRE_CASE();
+  const hidden_rooms::OccupancyGrid map = hidden_rooms::loadMap(caseDir() + "/map.yaml");
+  const hidden_rooms::DoorsFile doors = hidden_rooms::loadDoors(caseDir() + "/doors.yaml");
+  for (const std::string method : {"default", "thesis"}) {
+    SCOPED_TRACE(method);
+    PredictRooms service;
+    service.request.doors = hidden_rooms::toRos(doors);
+    service.request.method = method;  // map empty: the latest map on `map`, published by map_publisher
+    ASSERT_TRUE(call(&service));
+    ASSERT_TRUE(service.response.success) << service.response.message;
+    EXPECT_EQ(service.response.method, method);
+    ASSERT_EQ(service.response.rooms.size(), doors.doors.size());
+    EXPECT_GE(service.response.computation_time, 0.0);
+    EXPECT_EQ(service.response.completed_map.header.frame_id, "map");
+
+    const std::string offline = runOffline(method);
+    std::vector<hidden_rooms::RoomPrediction> rooms;
+    for (const hidden_rooms::PredictedRoom& room : service.response.rooms)
+      rooms.push_back(hidden_rooms::fromRos(room, map));
+    const cv::Mat1w labels = hidden_rooms::roomLabels(map, doors, rooms);
+    const cv::Mat expected = cv::imread(offline + "/rooms.png", cv::IMREAD_UNCHANGED);
+    ASSERT_FALSE(expected.empty());
+    cv::Mat1w expected_labels;
+    expected.convertTo(expected_labels, CV_16U);
+    EXPECT_EQ(cv::countNonZero(labels != expected_labels), 0) << "rooms differ from predict_rooms_offline's";
+    EXPECT_GT(cv::countNonZero(labels), 1000);
+
+    const hidden_rooms::OccupancyGrid completed = hidden_rooms::fromRos(service.response.completed_map);
+    const hidden_rooms::OccupancyGrid expected_completed = hidden_rooms::loadMap(offline + "/map.yaml");
+    ASSERT_EQ(completed.cells.size(), expected_completed.cells.size());
+    EXPECT_EQ(completed.resolution, expected_completed.resolution);
+    EXPECT_EQ(completed.origin, expected_completed.origin);
+    EXPECT_EQ(cv::countNonZero(completed.cells != expected_completed.cells), 0);
+
+    const YAML::Node yaml = YAML::LoadFile(offline + "/rooms.yaml");
+    for (size_t k = 0; k < rooms.size(); ++k) {
+      const hidden_rooms::PredictedRoom& room = service.response.rooms[k];
+      EXPECT_EQ(room.door_id, yaml["rooms"][k]["door_id"].as<int>());
+      EXPECT_EQ(room.label, k + 1);
+      EXPECT_EQ(room.status == hidden_rooms::PredictedRoom::PREDICTED, yaml["rooms"][k]["placed"].as<bool>());
+      EXPECT_NEAR(room.area, yaml["rooms"][k]["area"].as<double>(), 1e-9);
+      EXPECT_EQ(room.polygon.size(), yaml["rooms"][k]["polygon"].size());
+      EXPECT_EQ(room.term_names.size(), room.term_values.size());
+      if (room.status == hidden_rooms::PredictedRoom::PREDICTED) {
+        EXPECT_EQ(cv::countNonZero(rooms[k].mask), static_cast<int>(std::lround(room.area / (0.05 * 0.05))));
+        EXPECT_TRUE(room.problem.empty());
+      }
+    }
+  }
+}
+
+TEST(RoomPredictor, ClientSavesWhatTheOfflineCommandSaves) {
+  REQUIRE_CASE();
+  const std::string offline = runOffline("default");
+  const std::string out = testing_util::makeTempDir("room_predictor_client");
+  const testing_util::CommandResult result = testing_util::runCommand(
+      std::string(PREDICT_ROOMS_CLIENT_BIN) + " --doors " + caseDir() + "/doors.yaml --method default --out " + out);
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_NE(result.output.find("default: 15 doors in"), std::string::npos) << result.output;
+  for (const std::string file : {"rooms.png", "map.yaml", "map.pgm", "overlay.png"})
+    EXPECT_EQ(readFile(out + "/" + file), readFile(offline + "/" + file)) << file << " differs";
+  const YAML::Node client_yaml = YAML::LoadFile(out + "/rooms.yaml");
+  const YAML::Node offline_yaml = YAML::LoadFile(offline + "/rooms.yaml");
+  ASSERT_EQ(client_yaml["rooms"].size(), offline_yaml["rooms"].size());
+  for (size_t k = 0; k < client_yaml["rooms"].size(); ++k)
+    EXPECT_EQ(YAML::Dump(client_yaml["rooms"][k]), YAML::Dump(offline_yaml["rooms"][k]));
+
+  // Bad input: nothing written, exit code 2, the node's message.
+  const std::string bad_out = testing_util::makeTempDir("room_predictor_client_bad") + "/out";
+  const testing_util::CommandResult bad = testing_util::runCommand(std::string(PREDICT_ROOMS_CLIENT_BIN) + " --doors " +
+                                                                   caseDir() + "/doors.yaml --method nosuch --out " +
+                                                                   bad_out);
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
+  EXPECT_NE(bad.output.find("nosuch"), std::string::npos) << bad.output;
+  EXPECT_FALSE(std::filesystem::exists(bad_out));
+}
+
+TEST(RoomPredictor, EmptyRequestUsesTheDoorsFileAndTheNodesMethod) {
+  REQUIRE_CASE();
+  PredictRooms service;
+  ASSERT_TRUE(call(&service));
+  ASSERT_TRUE(service.response.success) << service.response.message;
+  EXPECT_EQ(service.response.method, "default");
+  EXPECT_EQ(service.response.rooms.size(), hidden_rooms::loadDoors(caseDir() + "/doors.yaml").doors.size());
+}
+
+TEST(RoomPredictor, PublishesLatchedOverlays) {
+  REQUIRE_CASE();
+  ros::NodeHandle nh;
+  // ~predict_on_map: the node predicted the file's doors as soon as the map arrived.
+  const auto completed = ros::topic::waitForMessage<nav_msgs::OccupancyGrid>("predicted_map", nh, ros::Duration(30.0));
+  ASSERT_TRUE(completed != nullptr);
+  const hidden_rooms::OccupancyGrid map = hidden_rooms::loadMap(caseDir() + "/map.yaml");
+  EXPECT_EQ(completed->info.width, static_cast<uint32_t>(map.width()));
+  EXPECT_EQ(completed->info.height, static_cast<uint32_t>(map.height()));
+  const auto markers =
+      ros::topic::waitForMessage<visualization_msgs::MarkerArray>("predicted_rooms", nh, ros::Duration(30.0));
+  ASSERT_TRUE(markers != nullptr);
+  std::map<std::string, int> per_namespace;
+  for (const visualization_msgs::Marker& marker : markers->markers) {
+    if (marker.action == visualization_msgs::Marker::DELETEALL) continue;
+    ++per_namespace[marker.ns];
+    EXPECT_EQ(marker.header.frame_id, "map");
+  }
+  EXPECT_EQ(markers->markers.front().action, visualization_msgs::Marker::DELETEALL);
+  EXPECT_GE(per_namespace["rooms"], 10);
+  EXPECT_EQ(per_namespace["rooms"], per_namespace["outlines"]);
+  EXPECT_EQ(per_namespace["rooms"], per_namespace["labels"]);
+  EXPECT_EQ(per_namespace["doors"], 1);
+  EXPECT_EQ(per_namespace["debug_extended_lines"], 1);  // ~publish_debug is on in the launch file
+  EXPECT_EQ(per_namespace["debug_in_out_cells"], 1);
+}
+
+TEST(RoomPredictor, WritesTheCompletedMapAsAnOctomap) {
+  REQUIRE_CASE();
+  ros::NodeHandle nh;
+  const auto completed =
+      ros::topic::waitForMessage<nav_msgs::OccupancyGrid>("octomap/predicted_map", nh, ros::Duration(60.0));
+  ASSERT_TRUE(completed != nullptr);
+  std::string path;
+  ASSERT_TRUE(nh.getParam("/octomap/room_predictor/octomap_out", path));
+  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(60.0);
+  while (!std::filesystem::exists(path) && ros::WallTime::now() < deadline) ros::WallDuration(0.1).sleep();
+  ASSERT_TRUE(std::filesystem::exists(path)) << "no 3D map written";
+  // Its band between floor and ceiling is the completed map, cut to its known cells.
+  const hidden_rooms::OccupancyGrid map = hidden_rooms::fromRos(*completed);
+  const hidden_rooms::OccupancyGrid sliced = hidden_rooms::sliceOctomap(path, hidden_rooms::SliceOptions());
+  const cv::Rect known = cv::boundingRect(map.cells != hidden_rooms::OccupancyGrid::kUnknown);
+  ASSERT_EQ(sliced.cells.size(), known.size());
+  EXPECT_EQ(cv::countNonZero(sliced.cells != map.cells(known)), 0);
+}
+
+void expectFailure(PredictRooms* service, const std::vector<std::string>& words, const std::string& name = "predict_rooms") {
+  ASSERT_TRUE(call(service, name)) << "the service call itself failed (node down?)";
+  EXPECT_FALSE(service->response.success);
+  for (const std::string& word : words)
+    EXPECT_NE(service->response.message.find(word), std::string::npos)
+        << "message '" << service->response.message << "' does not say '" << word << "'";
+  EXPECT_TRUE(service->response.rooms.empty());
+  EXPECT_EQ(service->response.completed_map.data.size(), 0u);
+}
+
+TEST(RoomPredictor, BadRequestsFailWithAMessageAndTheNodeKeepsServing) {
+  REQUIRE_CASE();
+  const hidden_rooms::DoorsFile doors = hidden_rooms::loadDoors(caseDir() + "/doors.yaml");
+  {
+    SCOPED_TRACE("door outside the map");
+    PredictRooms service;
+    service.request.doors = hidden_rooms::toRos(doors);
+    service.request.doors[1].position.x = -50.0;
+    expectFailure(&service, {"door " + std::to_string(doors.doors[1].id), "outside the map"});
+  }
+  {
+    SCOPED_TRACE("map with no known cell");
+    PredictRooms service;
+    service.request.doors = hidden_rooms::toRos(doors);
+    hidden_rooms::OccupancyGrid empty;
+    empty.cells = cv::Mat_<int8_t>(400, 400, hidden_rooms::OccupancyGrid::kUnknown);
+    service.request.map = hidden_rooms::toRos(empty, "map", ros::Time::now());
+    expectFailure(&service, {"map", "no known cell"});
+  }
+  {
+    SCOPED_TRACE("map with no free cell");
+    PredictRooms service;
+    service.request.doors = hidden_rooms::toRos(doors);
+    hidden_rooms::OccupancyGrid walls = hidden_rooms::loadMap(caseDir() + "/map.yaml");
+    walls.cells.setTo(hidden_rooms::OccupancyGrid::kOccupied);
+    service.request.map = hidden_rooms::toRos(walls, "map", ros::Time::now());
+    expectFailure(&service, {"map", "no free cell"});
+  }
+  {
+    SCOPED_TRACE("a map too large, thousands of doors, a NaN position");
+    PredictRooms huge;
+    huge.request.map.info.width = 100000;
+    huge.request.map.info.height = 100000;
+    huge.request.map.info.resolution = 0.05f;
+    const ros::WallTime start = ros::WallTime::now();
+    expectFailure(&huge, {"map", "max_map_cells"});
+    PredictRooms many;
+    many.request.doors.resize(5000, hidden_rooms::toRos(doors).front());
+    for (size_t k = 0; k < many.request.doors.size(); ++k) many.request.doors[k].id = static_cast<int>(k);
+    expectFailure(&many, {"5000 doors", "max_doors"});
+    EXPECT_LT((ros::WallTime::now() - start).toSec(), 5.0);
+    PredictRooms nan_door;
+    nan_door.request.doors = hidden_rooms::toRos(doors);
+    nan_door.request.doors[0].position.y = std::numeric_limits<double>::quiet_NaN();
+    expectFailure(&nan_door, {"door " + std::to_string(doors.doors[0].id), "finite"});
+  }
+  {
+    SCOPED_TRACE("map whose data does not match its size");
+    PredictRooms service;
+    service.request.map.info.width = 10;
+    service.request.map.info.height = 10;
+    service.request.map.info.resolution = 0.05f;
+    service.request.map.data.resize(7);
+    expectFailure(&service, {"map", "7 cells"});
+  }
+  {
+    SCOPED_TRACE("unknown method");
+    PredictRooms service;
+    service.request.method = "no_such_method";
+    expectFailure(&service, {"no_such_method", "default"});
+  }
+  {
+    SCOPED_TRACE("unknown parameter");
+    PredictRooms service;
+    hidden_rooms::PredictionParameter parameter;
+    parameter.name = "no_such_parameter";
+    parameter.value = 1.0;
+    service.request.parameters.push_back(parameter);
+    expectFailure(&service, {"no_such_parameter"});
+  }
+  {
+    SCOPED_TRACE("bad door width and orientation");
+    PredictRooms service;
+    service.request.doors = hidden_rooms::toRos(doors);
+    service.request.doors[0].width = -1.0;
+    expectFailure(&service, {"door " + std::to_string(doors.doors[0].id), "width"});
+    service.request.doors = hidden_rooms::toRos(doors);
+    service.request.doors[0].orientation = 7;
+    expectFailure(&service, {"orientation"});
+  }
+  {
+    SCOPED_TRACE("duplicate door id");
+    PredictRooms service;
+    service.request.doors = hidden_rooms::toRos(doors);
+    service.request.doors[1].id = service.request.doors[0].id;
+    expectFailure(&service, {"used twice"});
+  }
+  {
+    SCOPED_TRACE("no map yet, no doors file");
+    PredictRooms service;
+    service.request.doors = hidden_rooms::toRos(doors);
+    expectFailure(&service, {"no map", "/no_map/map"}, "/no_map/predict_rooms");
+    PredictRooms no_doors;
+    no_doors.request.map = hidden_rooms::toRos(hidden_rooms::loadMap(caseDir() + "/map.yaml"), "map", ros::Time::now());
+    expectFailure(&no_doors, {"no doors", "closed_doors_file"}, "/no_map/predict_rooms");
+  }
+  // Still serving, and a good request with its own map and a parameter override works.
+  PredictRooms service;
+  service.request.doors = hidden_rooms::toRos(doors);
+  service.request.map = hidden_rooms::toRos(hidden_rooms::loadMap(caseDir() + "/map.yaml"), "map", ros::Time::now());
+  service.request.method = "thesis";
+  hidden_rooms::PredictionParameter parameter;
+  parameter.name = "thesis_depth";
+  parameter.value = 3.0;
+  service.request.parameters.push_back(parameter);
+  ASSERT_TRUE(call(&service));
+  EXPECT_TRUE(service.response.success) << service.response.message;
+  EXPECT_EQ(service.response.rooms.size(), doors.doors.size());
+  PredictRooms again;
+  ASSERT_TRUE(call(&again, "/no_map/predict_rooms"));  // the other node is alive too
+  EXPECT_FALSE(again.response.success);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_room_predictor");
+  ros::NodeHandle nh;
+  return RUN_ALL_TESTS();
+}
