@@ -1,4 +1,5 @@
-"""The thesis's batch analysis (METHOD.md §8), driven from Python, computed by the C++ tool `batch_cases`.
+"""The thesis's batch analysis (docs/method.md#batch-analysis), driven from Python, computed by the C++ tool
+`batch_cases`.
 
 Per environment and batch: a random order of the closable doors (seeded by --seed, the environment's name and
 the batch number, so that every machine and every re-run draws the same doors), cut to --max-closed doors; case
@@ -31,7 +32,7 @@ LOCK_NAME = ".batch_analysis.lock"
 ALL_METHODS = ["default", "thesis", "unstructured", "structured", "skewnormal"]
 STDERR_EXCERPT_CHARS = 2000
 
-# Size classes by number of closable doors (METHOD.md §8, the thesis's classes).
+# Size classes by number of closable doors (docs/method.md#batch-analysis, the thesis's classes).
 SMALL_MAX_CLOSABLE = 9     # small: fewer than 10 closable doors
 MEDIUM_MAX_CLOSABLE = 15   # medium: 10 to 15; large: 16 or more
 SIZE_CLASSES = ["small", "medium", "large"]
@@ -331,8 +332,8 @@ def run_dask(tasks, scheduler, on_row):
 def parse_arguments(argv):
     parser = argparse.ArgumentParser(
         prog="batch_analysis",
-        description="The thesis's batch analysis (METHOD.md §8): per environment and batch, close the closable "
-                    "doors one at a time at random, cumulatively, erase the rooms behind them, run every method "
+        description="The thesis's batch analysis (docs/method.md#batch-analysis): per environment and batch, close "
+                    "the closable doors one at a time at random, cumulatively, erase the rooms behind them, run every method "
                     "and score it against the true rooms. Rows go to OUT/results.csv as they are done; re-running "
                     "the same command resumes.")
     parser.add_argument("--env", nargs="+", required=True, metavar="ENV.xml", help="environment XML file(s)")

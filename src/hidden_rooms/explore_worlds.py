@@ -1,11 +1,12 @@
-"""The thesis's exploration script (METHOD.md §10, thesis §5.1.5): explore simulated worlds with some doors closed.
+"""The thesis's exploration script (docs/method.md#exploration-runs, thesis §5.1.5): explore simulated worlds with some
+doors closed.
 
 Per world, in its own ROS master on a free port (so several worlds run side by side): exploration_run.launch
 (simulator, mapper, explorer, pose_logger, optionally a bag recorder). Every --timeout seconds of simulated time
 the map is saved (DIR/WORLD/maps/map_NNN); the run stops when the explorer reports done, when --patience saved
 maps in a row each grew by less than --growth over the one before, or at --max-time. Then the final map, the
-closed doors translated into the map frame (translate_doors, METHOD.md §2), the run's scores against its world
-and, with --method, the predicted rooms and their IoU are written. DIR/summary.csv has one row per world.
+closed doors translated into the map frame (translate_doors, docs/method.md#closed-doors-in-the-map), the run's scores
+against its world and, with --method, the predicted rooms and their IoU are written. DIR/summary.csv has one row per world.
 
 A re-run keeps the worlds already finished with the same settings (DIR/WORLD/result.json, written atomically)
 and runs the others again. Every child process gets SIGTERM when its parent dies, so a run killed even by SIGKILL

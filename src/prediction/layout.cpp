@@ -402,11 +402,11 @@ std::vector<ExtendedLine> wallLines(const Layout& layout, double merge_distance)
   return lines;
 }
 
-// Algorithm 1 (METHOD.md §3.3), read for its intent: every pair of closed doors must be separated by a line.
-// Doors farther apart in y than in x need a horizontal line (constant y) strictly between their y; otherwise a
-// vertical line strictly between their x. When no line of that axis lies strictly between them, one is added
-// through their midpoint (unless a line already lies within the merge distance of it). Lines added for earlier
-// pairs count for later pairs. Only lines strictly inside the boundary are added.
+// Algorithm 1 (docs/method.md#door-pair-lines), read for its intent: every pair of closed doors must be separated by
+// a line. Doors farther apart in y than in x need a horizontal line (constant y) strictly between their y; otherwise a
+// vertical line strictly between their x. When no line of that axis lies strictly between them, one is added through
+// their midpoint (unless a line already lies within the merge distance of it). Lines added for earlier pairs count for
+// later pairs. Only lines strictly inside the boundary are added.
 void addDoorPairLines(const std::vector<Point2>& doors, const cv::Rect& boundary, double merge_distance,
                       std::vector<ExtendedLine>* lines) {
   for (size_t i = 0; i < doors.size(); ++i)
@@ -515,12 +515,12 @@ void buildGrid(const OccupancyGrid& map, const LayoutOptions& options, Layout* l
   }
 }
 
-// DBSCAN of the IN cells. Distance between edge-adjacent cells: 1 - exp(-w / sigma) with w the wall fraction of
-// their shared edge (the affinity L of METHOD.md §3.6 turned into a distance); any other pair of distinct cells
-// has affinity 0, distance 1 > eps, so a neighbourhood is the cell itself plus its edge-adjacent IN cells with
-// w <= -sigma ln(1 - eps) (0.19 with the defaults). With min_points 1 the rooms are the connected components
-// of that graph. DBSCAN's noise cells (possible with min_points > 1) each become a room of their own, so that
-// every IN cell has a room.
+// DBSCAN of the IN cells. Distance between edge-adjacent cells: 1 - exp(-w / sigma) with w the wall fraction of their
+// shared edge (the affinity L of docs/method.md#rooms-of-in-cells turned into a distance); any other pair of
+// distinct cells has affinity 0, distance 1 > eps, so a neighbourhood is the cell itself plus its edge-adjacent IN
+// cells with w <= -sigma ln(1 - eps) (0.19 with the defaults). With min_points 1 the rooms are the connected components
+// of that graph. DBSCAN's noise cells (possible with min_points > 1) each become a room of their own, so that every IN
+// cell has a room.
 int segmentRooms(const LayoutOptions& options, CellGrid* grid) {
   const int count = grid->size();
   const int min_points = static_cast<int>(std::lround(options.dbscan_min_points));
@@ -565,10 +565,10 @@ int segmentRooms(const LayoutOptions& options, CellGrid* grid) {
   return rooms;
 }
 
-// ---------------------------------------------------------------------------------------------------------
-// Doors (METHOD.md §4.1): the nearest grid edge between an IN and an OUT cell, preferring edges parallel to
-// the door line (an O door lies on a horizontal edge, a V door on a vertical one) and falling back to the
-// other orientation when no parallel edge is within the search radius.
+// --------------------------------------------------------------------------------------------------------- Doors
+// (docs/method.md#door-start-cells): the nearest grid edge between an IN and an OUT cell, preferring edges parallel
+// to the door line (an O door lies on a horizontal edge, a V door on a vertical one) and falling back to the other
+// orientation when no parallel edge is within the search radius.
 
 double distanceToImageSegment(const Point2& p, const ImageSegment& s) { return distanceToSegment(p, s.a, s.b); }
 

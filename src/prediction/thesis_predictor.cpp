@@ -185,7 +185,7 @@ class Expansion {
         if (adjacent(static_cast<int>(a), static_cast<int>(b))) fixPair(static_cast<int>(a), static_cast<int>(b));
   }
 
-  // Border rooms' first stage: slide along the explored room the door leads from (§4.8).
+  // Border rooms' first stage: slide along the explored room the door leads from (docs/method.md#border-rooms).
   void growBorderRoom(int r, int explored_room) {
     Room& room = rooms_[r];
     bool grown = true;
@@ -249,8 +249,8 @@ class Expansion {
     }
   }
 
-  // One step at range 0 (§4.3): scores every connected subset of the candidates; applies the best one and
-  // returns the added cells (empty when the room stays as it is).
+  // One step at range 0 (docs/method.md#growing-a-room): scores every connected subset of the candidates; applies the
+  // best one and returns the added cells (empty when the room stays as it is).
   std::vector<int> expandOnce(int r) {
     Room& room = rooms_[r];
     room.dependent = isDependent(r);
@@ -472,8 +472,8 @@ class Expansion {
     return added;
   }
 
-  // §4.7: the cells added during expansion that touch the other room are exchangeable; every assignment of
-  // them is scored with -k1 sqrt(max(ar)/min(ar)) - k2 (co_a + co_b); the best replaces the pair.
+  // Pair fix (docs/method.md#pair-fix): the cells added during expansion that touch the other room are exchangeable;
+  // every assignment of them is scored with -k1 sqrt(max(ar)/min(ar)) - k2 (co_a + co_b); the best replaces the pair.
   void fixPair(int a, int b) {
     Room& ra = rooms_[a];
     Room& rb = rooms_[b];
@@ -563,8 +563,8 @@ class Expansion {
 
 enum class Growth { kUp, kDown, kLeft, kRight };
 
-// §4.8 second stage for one border room: the extent of its contact with the explored room along the door's
-// wall, and the direction away from the explored room.
+// Border rooms (docs/method.md#border-rooms), second stage for one border room: the extent of its contact with the
+// explored room along the door's wall, and the direction away from the explored room.
 struct BorderSide {
   Growth growth = Growth::kDown;
   int line = 0;       // the door's wall line (y for up/down, x for left/right), image coordinates
@@ -733,7 +733,7 @@ std::vector<ThesisRoomCells> thesisRoomCells(const Layout& layout, const ThesisO
   if (options.fix_pairs != 0.0) expansion.fixPairs();
 
   std::vector<Room>& rooms = expansion.rooms();
-  // §4.8: rooms whose start cell lies on the grid's border.
+  // Border rooms (docs/method.md#border-rooms): rooms whose start cell lies on the grid's border.
   struct Square {
     int room;
     BorderSide side;

@@ -9,7 +9,6 @@
 #include <opencv2/imgproc.hpp>
 
 #include "hidden_rooms/common/input_error.h"
-#include "hidden_rooms/common/label_image.h"
 #include "hidden_rooms/prediction/prediction_support.h"
 
 namespace hidden_rooms {
@@ -24,95 +23,15 @@ double floatToDouble(float value) {
   return std::strtod(text, nullptr);
 }
 
-std_msgs::ColorRGBA colour(double r, double g, double b, double a) {
-  std_msgs::ColorRGBA c;
-  c.r = static_cast<float>(r);
-  c.g = static_cast<float>(g);
-  c.b = static_cast<float>(b);
-  c.a = static_cast<float>(a);
-  return c;
-}
-
-std_msgs::ColorRGBA roomColourRgba(int label, double alpha) {
-  const cv::Vec3b bgr = roomColour(label);
-  return colour(bgr[2] / 255.0, bgr[1] / 255.0, bgr[0] / 255.0, alpha);
-}
-
-geometry_msgs::Point point(double x, double y, double z) {
-  geometry_msgs::Point p;
-  p.x = x;
-  p.y = y;
-  p.z = z;
-  return p;
-}
-
-// A map-frame point of continuous image coordinates (x = column, y = row from the top).
-geometry_msgs::Point imagePoint(const OccupancyGrid& map, double x, double y, double z) {
-  return point(map.origin.x() + x * map.resolution, map.origin.y() + (map.height() - y) * map.resolution, z);
-}
-
-visualization_msgs::Marker newMarker(const std::string& ns, int id, int type, const std::string& frame_id,
-                                     const ros::Time& stamp) {
-  visualization_msgs::Marker marker;
-  marker.header.frame_id = frame_id;
-  marker.header.stamp = stamp;
-  marker.ns = ns;
-  marker.id = id;
-  marker.type = type;
-  marker.action = visualization_msgs::Marker::ADD;
-  marker.pose.orientation.w = 1.0;
-  marker.scale.x = marker.scale.y = marker.scale.z = 1.0;
-  marker.color = colour(1.0, 1.0, 1.0, 1.0);
-  return marker;
-}
-
-// Two triangles per axis-aligned image rectangle [x0, x1) x [y0, y1).
-void addRectangle(const OccupancyGrid& map, double x0, double y0, double x1, double y1, double z,
-                  const std_msgs::ColorRGBA* vertex_colour, visualization_msgs::Marker* marker) {
-  const geometry_msgs::Point a = imagePoint(map, x0, y1, z), b = imagePoint(map, x1, y1, z),
-                             c = imagePoint(map, x1, y0, z), d = imagePoint(map, x0, y0, z);
-  for (const geometry_msgs::Point& p : {a, b, c, a, c, d}) {
-    marker->points.push_back(p);
-    if (vertex_colour != nullptr) marker->colors.push_back(*vertex_colour);
-  }
-}
-
-// The cells of a mask as few rectangles: runs of each row, stacked while the next row has the same run.
-void addMaskTriangles(const OccupancyGrid& map, const cv::Mat1b& mask, double z, visualization_msgs::Marker* marker) {
-  std::vector<cv::Point> cells;
-  cv::findNonZero(mask, cells);
-  if (cells.empty()) return;
-  const cv::Rect box = cv::boundingRect(cells);
-  std::map<std::pair<int, int>, int> open;  // run [begin, end) -> first row
-  auto close_runs = [&](const std::set<std::pair<int, int>>& keep, int row) {
-    for (auto it = open.begin(); it != open.end();) {
-      if (keep.count(it->first) == 0) {
-        addRectangle(map, it->first.first, it->second, it->first.second, row, z, nullptr, marker);
-        it = open.erase(it);
-      } else {
-        ++it;
-      }
-    }
-  };
-  for (int row = box.y; row < box.y + box.height; ++row) {
-    std::set<std::pair<int, int>> runs;
-    const uchar* line = mask.ptr<uchar>(row);
-    for (int col = box.x; col < box.x + box.width;) {
-      if (line[col] == 0) {
-        ++col;
-        continue;
-      }
-      const int begin = col;
-      while (col < box.x + box.width && line[col] != 0) ++col;
-      runs.insert({begin, col});
-    }
-    close_runs(runs, row);
-    for (const auto& run : runs) open.emplace(run, row);
-  }
-  close_runs({}, box.y + box.height);
-}
-
 }  // namespace
+
+geometry_msgs::Point toRos(const Point2& point, double z) {
+  geometry_msgs::Point message;
+  message.x = point.x();
+  message.y = point.y();
+  message.z = z;
+  return message;
+}
 
 nav_msgs::OccupancyGrid toRos(const OccupancyGrid& grid, const std::string& frame_id, const ros::Time& stamp) {
   nav_msgs::OccupancyGrid message;
@@ -223,7 +142,7 @@ hidden_rooms::PredictedRoom toRos(const RoomPrediction& room, int label, const O
   message.label = static_cast<uint32_t>(label);
   message.status = room.placed ? hidden_rooms::PredictedRoom::PREDICTED : hidden_rooms::PredictedRoom::NOT_PLACED;
   message.problem = room.placed ? "" : room.problem;
-  for (const Point2& p : room.polygon) message.polygon.push_back(point(p.x(), p.y(), 0.0));
+  for (const Point2& p : room.polygon) message.polygon.push_back(toRos(p, 0.0));
   message.area = room.area;
   const auto score = room.terms.find("score");
   message.score = score != room.terms.end() ? score->second : std::numeric_limits<double>::quiet_NaN();
@@ -273,93 +192,6 @@ RoomPrediction fromRos(const hidden_rooms::PredictedRoom& message, const Occupan
     throw InputError(source, "mask reaches outside the map");
   room.mask(cv::Rect(col, row, crop.width(), crop.height())).setTo(255, crop.cells == OccupancyGrid::kFree);
   return room;
-}
-
-visualization_msgs::MarkerArray toMarkers(const OccupancyGrid& map, const DoorsFile& doors,
-                                          const std::vector<RoomPrediction>& rooms, const cv::Mat1w& labels,
-                                          const std::string& frame_id, const ros::Time& stamp) {
-  using visualization_msgs::Marker;
-  visualization_msgs::MarkerArray array;
-  Marker clear = newMarker("", 0, Marker::CUBE, frame_id, stamp);
-  clear.action = Marker::DELETEALL;
-  array.markers.push_back(clear);
-  for (size_t k = 0; k < rooms.size(); ++k) {
-    const RoomPrediction& room = rooms[k];
-    const int label = static_cast<int>(k) + 1;
-    if (!room.placed) continue;
-    const cv::Mat1b cells = labels == label;
-    Marker fill = newMarker("rooms", room.door_id, Marker::TRIANGLE_LIST, frame_id, stamp);
-    fill.color = roomColourRgba(label, 0.55);
-    addMaskTriangles(map, cells, 0.01, &fill);
-    if (!fill.points.empty()) array.markers.push_back(fill);
-    if (room.polygon.size() >= 2) {
-      Marker outline = newMarker("outlines", room.door_id, Marker::LINE_STRIP, frame_id, stamp);
-      outline.scale.x = 2.0 * map.resolution;
-      outline.color = roomColourRgba(label, 1.0);
-      for (const Point2& p : room.polygon) outline.points.push_back(point(p.x(), p.y(), 0.02));
-      outline.points.push_back(outline.points.front());
-      array.markers.push_back(outline);
-    }
-    const cv::Moments moments = cv::moments(cells, true);
-    const cv::Mat1b own = room.mask;
-    const cv::Moments fallback = moments.m00 > 0 ? moments : cv::moments(own, true);
-    if (fallback.m00 > 0) {
-      Marker text = newMarker("labels", room.door_id, Marker::TEXT_VIEW_FACING, frame_id, stamp);
-      text.pose.position = imagePoint(map, fallback.m10 / fallback.m00 + 0.5, fallback.m01 / fallback.m00 + 0.5, 0.5);
-      text.scale.z = 1.0;  // metres: text height
-      char area[32];
-      std::snprintf(area, sizeof(area), "%.1f", room.area);
-      text.text = "door " + std::to_string(room.door_id) + "\n" + area + " m2";
-      array.markers.push_back(text);
-    }
-  }
-  Marker door_lines = newMarker("doors", 0, Marker::LINE_LIST, frame_id, stamp);
-  door_lines.scale.x = 0.3;  // metres: line width
-  for (size_t k = 0; k < doors.doors.size(); ++k) {
-    const MapDoor& door = doors.doors[k];
-    const bool placed = k < rooms.size() && rooms[k].placed;
-    const std_msgs::ColorRGBA c = placed ? colour(0.9, 0.1, 0.1, 1.0) : colour(0.5, 0.5, 0.5, 1.0);
-    const Point2 half = door.orientation == DoorOrientation::kAlongX ? Point2(door.width / 2, 0) : Point2(0, door.width / 2);
-    for (const Point2& p : {Point2(door.position - half), Point2(door.position + half)}) {
-      door_lines.points.push_back(point(p.x(), p.y(), 0.03));
-      door_lines.colors.push_back(c);
-    }
-  }
-  if (!door_lines.points.empty()) array.markers.push_back(door_lines);
-  return array;
-}
-
-visualization_msgs::MarkerArray toDebugMarkers(const OccupancyGrid& map, const Layout& layout,
-                                               const std::string& frame_id, const ros::Time& stamp) {
-  using visualization_msgs::Marker;
-  visualization_msgs::MarkerArray array;
-  const CellGrid& grid = layout.grid;
-  if (grid.xs.size() < 2 || grid.ys.size() < 2) return array;
-  Marker lines = newMarker("debug_extended_lines", 0, Marker::LINE_LIST, frame_id, stamp);
-  lines.scale.x = map.resolution;
-  for (const ExtendedLine& line : layout.lines) {
-    const std_msgs::ColorRGBA c = line.source == LineSource::kWall       ? colour(0.2, 0.4, 1.0, 1.0)
-                                  : line.source == LineSource::kDoorPair ? colour(1.0, 0.6, 0.0, 1.0)
-                                                                         : colour(0.6, 0.6, 0.6, 1.0);
-    if (line.axis == LineAxis::kHorizontal) {
-      lines.points.push_back(imagePoint(map, grid.xs.front(), line.position, 0.04));
-      lines.points.push_back(imagePoint(map, grid.xs.back(), line.position, 0.04));
-    } else {
-      lines.points.push_back(imagePoint(map, line.position, grid.ys.front(), 0.04));
-      lines.points.push_back(imagePoint(map, line.position, grid.ys.back(), 0.04));
-    }
-    lines.colors.push_back(c);
-    lines.colors.push_back(c);
-  }
-  if (!lines.points.empty()) array.markers.push_back(lines);
-  Marker cells = newMarker("debug_in_out_cells", 0, Marker::TRIANGLE_LIST, frame_id, stamp);
-  for (const LayoutCell& cell : grid.cells) {
-    const std_msgs::ColorRGBA c = cell.out ? colour(0.9, 0.2, 0.2, 0.25) : colour(0.2, 0.8, 0.2, 0.25);
-    addRectangle(map, cell.rect.x, cell.rect.y, cell.rect.x + cell.rect.width, cell.rect.y + cell.rect.height, 0.005,
-                 &c, &cells);
-  }
-  if (!cells.points.empty()) array.markers.push_back(cells);
-  return array;
 }
 
 VelocityCommand fromRos(const geometry_msgs::Twist& message) { return {message.linear.x, message.angular.z}; }

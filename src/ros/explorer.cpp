@@ -9,29 +9,9 @@
 #include "hidden_rooms/common/input_error.h"
 #include "hidden_rooms/common/range_scan.h"
 #include "hidden_rooms/ros/conversions.h"
+#include "hidden_rooms/ros/markers.h"
 
 namespace hidden_rooms {
-
-namespace {
-
-geometry_msgs::Point toPoint(const Point2& point, double z = 0.05) {
-  geometry_msgs::Point message;
-  message.x = point.x();
-  message.y = point.y();
-  message.z = z;
-  return message;
-}
-
-std_msgs::ColorRGBA colour(float r, float g, float b, float a = 1.0f) {
-  std_msgs::ColorRGBA message;
-  message.r = r;
-  message.g = g;
-  message.b = b;
-  message.a = a;
-  return message;
-}
-
-}  // namespace
 
 ExplorerOptions readExplorerOptions(const ros::NodeHandle& nh) {
   ExplorerOptions options;
@@ -394,70 +374,17 @@ void Explorer::publishCommand(const VelocityCommand& command) {
 
 void Explorer::publishMarkers(const FrontierMap& frontiers, const ros::Time& now) {
   if (markers_publisher_.getNumSubscribers() == 0) return;
-  visualization_msgs::MarkerArray markers;
-  visualization_msgs::Marker clear;
-  clear.action = visualization_msgs::Marker::DELETEALL;
-  markers.markers.push_back(clear);
-  const OccupancyGrid& map = planner_.map();
-
-  visualization_msgs::Marker cells;
-  cells.header.frame_id = options_.map_frame;
-  cells.header.stamp = now;
-  cells.ns = "frontiers";
-  cells.type = visualization_msgs::Marker::CUBE_LIST;
-  cells.pose.orientation.w = 1.0;
-  cells.scale.x = cells.scale.y = map.resolution;
-  cells.scale.z = 0.02;
-  for (const Frontier& frontier : frontiers.frontiers) {
-    const bool chosen = goal_ && frontier.label == goal_->frontier_label;
-    for (const cv::Point& cell : frontier.cells) {
-      cells.points.push_back(toPoint(map.cellCentre(cell.x, cell.y), 0.01));
-      cells.colors.push_back(chosen ? colour(1.0f, 0.5f, 0.0f) : colour(0.1f, 0.4f, 1.0f));
-    }
-  }
-  if (!cells.points.empty()) markers.markers.push_back(cells);
-
+  ExplorationView view;
+  view.frontiers = &frontiers;
   if (goal_) {
-    visualization_msgs::Marker goal = cells;
-    goal.ns = "goal";
-    goal.type = visualization_msgs::Marker::SPHERE;
-    goal.points.clear();
-    goal.colors.clear();
-    goal.pose.position = toPoint(goal_->position, 0.1);
-    goal.scale.x = goal.scale.y = goal.scale.z = 0.3;
-    goal.color = colour(1.0f, 0.5f, 0.0f);
-    markers.markers.push_back(goal);
-
-    visualization_msgs::Marker path = cells;
-    path.ns = "path";
-    path.type = visualization_msgs::Marker::LINE_STRIP;
-    path.points.clear();
-    path.colors.clear();
-    path.scale.x = 0.05;
-    path.color = colour(0.0f, 0.8f, 0.2f);
-    for (const Point2& point : follower_.path()) path.points.push_back(toPoint(point));
-    if (path.points.size() >= 2) markers.markers.push_back(path);
+    view.goal_frontier_label = goal_->frontier_label;
+    view.goal = goal_->position;
+    view.path = follower_.path();
   }
-
-  // Places as spheres of `diameter` metres (flattened to `height`) at `z`.
-  const auto spheres = [&](const char* ns, const std::vector<Point2>& places, double diameter, double height,
-                           double z, const std_msgs::ColorRGBA& tint) {
-    if (places.empty()) return;
-    visualization_msgs::Marker marker = cells;
-    marker.ns = ns;
-    marker.type = visualization_msgs::Marker::SPHERE_LIST;
-    marker.points.clear();
-    marker.colors.clear();
-    marker.scale.x = marker.scale.y = diameter;
-    marker.scale.z = height;
-    marker.color = tint;
-    for (const Point2& place : places) marker.points.push_back(toPoint(place, z));
-    markers.markers.push_back(marker);
-  };
-  spheres("blacklist", blacklist_.points, 0.2, 0.2, 0.1, colour(1.0f, 0.0f, 0.0f, 0.8f));
-  spheres("blocked_passages", passages_.blockedPoints(), 2.0 * options_.passages.radius, 0.05, 0.05,
-          colour(0.6f, 0.0f, 0.6f, 0.6f));
-  markers_publisher_.publish(markers);
+  view.blacklist = blacklist_.points;
+  view.blocked_passages = passages_.blockedPoints();
+  view.blocked_passage_radius = options_.passages.radius;
+  markers_publisher_.publish(toMarkers(planner_.map(), view, options_.map_frame, now));
 }
 
 }  // namespace hidden_rooms

@@ -11,6 +11,7 @@
 #include "hidden_rooms/prediction/layout.h"
 #include "hidden_rooms/prediction/prediction_support.h"
 #include "hidden_rooms/ros/conversions.h"
+#include "hidden_rooms/ros/markers.h"
 
 namespace hidden_rooms {
 

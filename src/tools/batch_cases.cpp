@@ -1,8 +1,8 @@
-// batch_cases ENV.xml --sequence D1,D2,... --methods A,B [--cases K,...] [options]: the cases of one batch of
-// the thesis's batch analysis (METHOD.md §8), all methods in one process. Case k closes the first k doors of the
-// sequence (door numbers, closing order), erases the rooms behind them, runs every method and scores it; one
-// JSON line per case goes to stdout as soon as it is done. `batch_cases ENV.xml --info` prints the
-// environment's closable doors. scripts/batch_analysis drives it.
+// batch_cases ENV.xml --sequence D1,D2,... --methods A,B [--cases K,...] [options]: the cases of one batch of the
+// thesis's batch analysis (docs/method.md#batch-analysis), all methods in one process. Case k closes the first k
+// doors of the sequence (door numbers, closing order), erases the rooms behind them, runs every method and scores it;
+// one JSON line per case goes to stdout as soon as it is done. `batch_cases ENV.xml --info` prints the environment's
+// closable doors. scripts/batch_analysis drives it.
 #include <filesystem>
 #include <iomanip>
 #include <iostream>

@@ -1,6 +1,6 @@
-// translate_doors --environment ENV.xml --closed SPEC --truth GT.log --estimate MAP.log --out DIR [--map MAP.yaml]:
-// the closed doors of a simulated exploration placed in the map the robot built (METHOD.md §2) and, with the
-// map, the run scored against the world it explored.
+// translate_doors --environment ENV.xml --closed SPEC --truth GT.log --estimate MAP.log --out DIR [--map MAP.yaml]: the
+// closed doors of a simulated exploration placed in the map the robot built (docs/method.md#closed-doors-in-the-map)
+// and, with the map, the run scored against the world it explored.
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -61,10 +61,11 @@ int run(int argc, char** argv) {
                         "Usage: translate_doors --environment ENV.xml --closed SPEC --truth GT.log --estimate MAP.log\n"
                         "                       --out DIR [--map MAP.yaml]\n"
                         "Writes DIR/doors.yaml: the closed doors in the map frame, each carried over from the world\n"
-                        "by the robot pose closest to it (METHOD.md 2). With --map also DIR/true_rooms.png (label k =\n"
-                        "the room behind the k-th door, in the map's grid) and DIR/exploration.yaml: coverage of the\n"
-                        "reachable free area, map quality, path length and each door's translation error (against\n"
-                        "the world placed by the poses within 5 m of the door, and by the whole run).",
+                        "by the robot pose closest to it (docs/method.md#closed-doors-in-the-map). With --map also\n"
+                        "DIR/true_rooms.png (label k = the room behind the k-th door, in the map's grid) and\n"
+                        "DIR/exploration.yaml: coverage of the reachable free area, map quality, path length and each\n"
+                        "door's translation error (against the world placed by the poses within 5 m of the door, and\n"
+                        "by the whole run).",
                         options, positional, &values))
     return kExitOk;
   if (!(door_width > 0.0)) throw InputError("--door-width", "must be positive");

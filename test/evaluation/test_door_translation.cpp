@@ -1,4 +1,5 @@
-// Pose logs, the door translation of METHOD.md §2, trajectory alignment and the truth moved into a map's grid.
+// Pose logs, the door translation of docs/method.md#closed-doors-in-the-map, trajectory alignment and the truth
+// moved into a map's grid.
 #include <cmath>
 #include <fstream>
 #include <limits>

@@ -1,5 +1,5 @@
-// The thesis's method ("thesis", METHOD.md §4): score terms, expansion on synthetic maps, determinism,
-// parameters and the accuracy on the closed-door benchmark.
+// The thesis's method ("thesis", docs/method.md#the-thesis-method): score terms, expansion on synthetic maps,
+// determinism, parameters and the accuracy on the closed-door benchmark.
 #include <gtest/gtest.h>
 
 #include <fstream>

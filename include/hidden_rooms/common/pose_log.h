@@ -13,9 +13,9 @@ struct TimedPose {
   Pose2 pose;
 };
 
-// A pose log as the pose_logger node writes it (the thesis's listener, METHOD.md §10): '#' comment lines, then
-// one pose per line, "time x y yaw" (seconds, metres, metres, radians), times strictly increasing. The first
-// comment names the frames ("# frame: map -> base_link").
+// A pose log as the pose_logger node writes it (the thesis's listener, docs/method.md#exploration-runs): '#' comment
+// lines, then one pose per line, "time x y yaw" (seconds, metres, metres, radians), times strictly increasing. The
+// first comment names the frames ("# frame: map -> base_link").
 struct PoseLog {
   std::string parent_frame;
   std::string child_frame;

@@ -1,7 +1,7 @@
 #pragma once
-// One case of the thesis's batch analysis (METHOD.md §8): an environment with some closable doors closed, the
-// rooms behind them erased to unknown and the doors painted as walls, every method run on it and scored against
-// the true rooms. `batch_cases` (src/tools) runs the cases of one batch; scripts/batch_analysis drives it.
+// One case of the thesis's batch analysis (docs/method.md#batch-analysis): an environment with some closable doors
+// closed, the rooms behind them erased to unknown and the doors painted as walls, every method run on it and scored
+// against the true rooms. `batch_cases` (src/tools) runs the cases of one batch; scripts/batch_analysis drives it.
 #include <map>
 #include <string>
 #include <vector>

@@ -13,8 +13,8 @@
 
 namespace hidden_rooms {
 
-// Where a door of the world lies in the map a robot built (METHOD.md §2). `truth` is the robot's true trajectory
-// (world frame), `estimate` its SLAM trajectory (map frame), both timed on the same clock.
+// Where a door of the world lies in the map a robot built (docs/method.md#closed-doors-in-the-map). `truth` is the
+// robot's true trajectory (world frame), `estimate` its SLAM trajectory (map frame), both timed on the same clock.
 struct DoorInMap {
   Point2 position = Point2::Zero();  // map frame, metres
   double wall_angle = 0.0;           // direction of the door's wall in the map frame, radians in [0, pi)

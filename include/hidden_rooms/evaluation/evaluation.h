@@ -6,8 +6,8 @@
 
 namespace hidden_rooms {
 
-// Scores of a prediction against the truth, METHOD.md §7. Label images hold k on the cells of the room behind
-// the k-th door (1-based) and 0 elsewhere (8- or 16-bit).
+// Scores of a prediction against the truth, docs/method.md#evaluation. Label images hold k on the cells of the room
+// behind the k-th door (1-based) and 0 elsewhere (8- or 16-bit).
 struct RoomScores {
   std::vector<double> iou;  // per door k = 1..door_count: |P_k ∩ T_k| / |P_k ∪ T_k|; 0 when both are empty
   double mean_iou = 0.0;    // mean over the doors (a door with no prediction scores 0)

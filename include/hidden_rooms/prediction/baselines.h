@@ -1,7 +1,7 @@
 #pragma once
 
-// The thesis's unstructured baseline (METHOD.md §6) and the skew-normal door extrapolation of the related work
-// (seed 001), behind the RoomPredictor interface. The structured baseline is in structured_predictor.h.
+// The thesis's unstructured baseline (docs/method.md#baselines) and the skew-normal door extrapolation of the
+// related work (seed 001), behind the RoomPredictor interface. The structured baseline is in structured_predictor.h.
 
 #include <string>
 #include <vector>

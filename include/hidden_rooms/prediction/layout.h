@@ -1,9 +1,9 @@
 #pragma once
 
-// Layout analysis of an occupancy grid map (METHOD.md §3 and §4.1): walls from edge detection and a Hough
-// transform, clustered by angle (mean shift) and by lateral distance; one axis-aligned extended line per wall,
-// plus lines separating pairs of closed doors and four boundary lines; the rectangular cells those lines cut;
-// IN/OUT cells, wall weights of the edges between cells, rooms of IN cells (DBSCAN), and the starting cell of
+// Layout analysis of an occupancy grid map (docs/method.md#layout-analysis and #door-start-cells): walls from edge
+// detection and a Hough transform, clustered by angle (mean shift) and by lateral distance; one axis-aligned extended
+// line per wall, plus lines separating pairs of closed doors and four boundary lines; the rectangular cells those lines
+// cut; IN/OUT cells, wall weights of the edges between cells, rooms of IN cells (DBSCAN), and the starting cell of
 // every closed door.
 //
 // Image coordinates: x = column, y = row (row 0 at the top, as in OccupancyGrid::cells), continuous: pixel
@@ -122,7 +122,8 @@ struct CellGrid {
   int cellAt(const Point2& image_point) const;
 };
 
-// Where a closed door enters the cell grid (METHOD.md §4.1): the nearest edge between an IN and an OUT cell.
+// Where a closed door enters the cell grid (docs/method.md#door-start-cells): the nearest edge between an IN and an
+// OUT cell.
 struct DoorStart {
   int door_id = 0;
   bool found = false;

@@ -40,8 +40,8 @@ void checkUsableMap(const OccupancyGrid& map);
 // InputError("doors", ...) when two doors share an id.
 void checkDoorsInsideMap(const OccupancyGrid& map, const DoorsFile& doors);
 
-// The input map completed with the predicted rooms (METHOD.md §5): each placed room's cells free, unknown
-// cells around it walled, and its door opened as a free rectangle of the door's width joining the room to the
+// The input map completed with the predicted rooms (docs/method.md#completed-map): each placed room's cells free,
+// unknown cells around it walled, and its door opened as a free rectangle of the door's width joining the room to the
 // explored side.
 OccupancyGrid insertRooms(const OccupancyGrid& map, const DoorsFile& doors, const std::vector<RoomPrediction>& rooms);
 

@@ -1,6 +1,6 @@
 #pragma once
 
-// The thesis's structured baseline (METHOD.md §6) behind the RoomPredictor interface.
+// The thesis's structured baseline (docs/method.md#baselines) behind the RoomPredictor interface.
 
 #include <map>
 #include <string>

@@ -1,7 +1,7 @@
 #pragma once
 
-// The thesis's method (METHOD.md §4) behind the RoomPredictor interface: hidden rooms grown cell by cell on the
-// layout's cell grid (layout.h), scored by the thesis's utility functions.
+// The thesis's method (docs/method.md#the-thesis-method) behind the RoomPredictor interface: hidden rooms grown cell
+// by cell on the layout's cell grid (layout.h), scored by the thesis's utility functions.
 
 #include <map>
 #include <string>
@@ -30,11 +30,11 @@ struct ThesisOptions {
   double outcast_min_neighbours = 2.0; // a room cell with n >= this many free neighbours costs n - (this - 1)
   double depth = 7.0;                  // greedy expansion steps (level of depth l)
   double max_candidates = 12.0;        // candidates per expansion step (2^n subsets are scored)
-  double fix_pairs = 1.0;              // 1: exchange cells between adjacent rooms (METHOD.md §4.7); 0: not
+  double fix_pairs = 1.0;              // 1: exchange cells between adjacent rooms (docs/method.md#pair-fix); 0: not
   double fix_k1 = 1.0;                 // pair score: -k1 sqrt(max area / min area) - k2 (co_i + co_j)
   double fix_k2 = 1.0;
   double max_exchangeable = 12.0;      // exchangeable cells per pair (2^n assignments are scored)
-  double border_rooms = 1.0;           // 1: grow rooms starting on a border cell into squares (§4.8); 0: not
+  double border_rooms = 1.0;           // 1: border-cell rooms grow into squares (docs/method.md#border-rooms); 0: not
   double border_cells_free = 0.0;      // 1: OUT border cells count as free in fe and oc; 0: they do not
 };
 
@@ -45,9 +45,9 @@ std::map<std::string, double> thesisParameters(const ThesisOptions& options);
 // InputError("parameters", "parameter 'x' ...") on a bad value.
 ThesisOptions thesisOptionsFromParameters(const std::map<std::string, double>& parameters);
 
-// The score terms of a room made of grid cells (METHOD.md §4.5). A cell is *free* when it is OUT, not in the
-// room and not in `taken` (cells of the other predicted rooms; may be empty = none taken). Adjacency is
-// through shared edges.
+// The score terms of a room made of grid cells (docs/method.md#score-terms). A cell is *free* when it is OUT, not in
+// the room and not in `taken` (cells of the other predicted rooms; may be empty = none taken). Adjacency is through
+// shared edges.
 struct ThesisTerms {
   double co = 0.0;  // (area of the convex hull of the cells' corners - area) / area
   double fe = 0.0;  // free cells adjacent to the room / all cells adjacent to the room
@@ -65,7 +65,8 @@ double thesisScore(const ThesisTerms& terms, bool dependent, const ThesisOptions
 // has no start), and per door whether it was a border room, capped, its expansion steps and final status.
 struct ThesisRoomCells {
   std::vector<int> cells;
-  bool border_room = false;       // start cell is a border cell: the final room is the square of §4.8
+  // The start cell is a border cell: the final room is a square (docs/method.md#border-rooms).
+  bool border_room = false;
   cv::Rect square;                // border rooms: the square, image coordinates (empty otherwise)
   bool dependent = false;
   bool candidates_capped = false;

@@ -16,17 +16,18 @@
 #include <nav_msgs/OccupancyGrid.h>
 #include <ros/time.h>
 #include <sensor_msgs/LaserScan.h>
-#include <visualization_msgs/MarkerArray.h>
 
 #include "hidden_rooms/common/doors_file.h"
 #include "hidden_rooms/common/occupancy_grid.h"
 #include "hidden_rooms/common/range_scan.h"
 #include "hidden_rooms/mapping/rbpf_mapper.h"
-#include "hidden_rooms/prediction/layout.h"
 #include "hidden_rooms/prediction/room_predictor.h"
 #include "hidden_rooms/simulation/simulation.h"
 
 namespace hidden_rooms {
+
+// A map-frame point at height `z`.
+geometry_msgs::Point toRos(const Point2& point, double z);
 
 // Core grids keep row 0 at the top (image order); nav_msgs keeps row 0 at the origin (bottom).
 nav_msgs::OccupancyGrid toRos(const OccupancyGrid& grid, const std::string& frame_id, const ros::Time& stamp);
@@ -53,18 +54,6 @@ hidden_rooms::PredictedRoom toRos(const RoomPrediction& room, int label, const O
 // The room back with its mask at the map's size (255 on its cells). Throws InputError when the mask does not lie
 // on the map's cell grid or term names and values differ in length.
 RoomPrediction fromRos(const hidden_rooms::PredictedRoom& message, const OccupancyGrid& map);
-
-// rviz overlays of a prediction, in `frame_id`: a DELETEALL marker first (so that fewer rooms than last time
-// leave nothing behind), then per predicted room a filled area (namespace "rooms", the cells of its label in
-// `labels`, colour of roomColour()), its outline ("outlines"), a text with door id and area ("labels"); every
-// door as a thick line across its width ("doors": red when its room is predicted, grey when not placed).
-visualization_msgs::MarkerArray toMarkers(const OccupancyGrid& map, const DoorsFile& doors,
-                                          const std::vector<RoomPrediction>& rooms, const cv::Mat1w& labels,
-                                          const std::string& frame_id, const ros::Time& stamp);
-// Debug overlays of the layout analysis: its extended lines ("debug_extended_lines": walls blue, door-pair lines
-// orange, boundary lines grey) and its cells ("debug_in_out_cells": IN cells green, OUT cells red, translucent).
-visualization_msgs::MarkerArray toDebugMarkers(const OccupancyGrid& map, const Layout& layout,
-                                               const std::string& frame_id, const ros::Time& stamp);
 
 // Simulator. A velocity command as it came (non-finite values pass: Simulation::setCommand rejects them).
 VelocityCommand fromRos(const geometry_msgs::Twist& message);

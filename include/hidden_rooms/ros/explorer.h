@@ -16,7 +16,7 @@
 
 namespace hidden_rooms {
 
-// Parameters of the explorer node (all private, ~name; see README.md and config/explorer.yaml).
+// Parameters of the explorer node (all private, ~name; see docs/ros_api.md and config/explorer.yaml).
 struct ExplorerOptions {
   GridPlannerOptions planner;    // inflation, proximity cost, smoothing
   FrontierOptions frontiers;     // frontier filtering, goal reach

@@ -19,7 +19,7 @@
 
 namespace hidden_rooms {
 
-// Parameters of the mapper node (all private, ~name; see README.md and config/mapper.yaml).
+// Parameters of the mapper node (all private, ~name; see docs/ros_api.md and config/mapper.yaml).
 struct MapperOptions {
   RbpfMapperOptions rbpf;             // ~config_file (MRPT ini), ~seed
   std::string scan_topic = "base_scan";

@@ -11,7 +11,7 @@
 
 namespace hidden_rooms {
 
-// Parameters of the pose_logger node (all private, ~name; see README.md).
+// Parameters of the pose_logger node (all private, ~name; see docs/ros_api.md).
 struct PoseLoggerOptions {
   std::string estimate_log = "poses_map.log";   // tf map_frame -> base_frame, one line per period
   std::string ground_truth_log;                 // base_pose_ground_truth at the same period; "" = not logged

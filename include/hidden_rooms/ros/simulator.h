@@ -17,7 +17,7 @@
 
 namespace hidden_rooms {
 
-// Parameters of the simulator node (all private, ~name; see README.md and config/simulation.yaml).
+// Parameters of the simulator node (all private, ~name; see docs/ros_api.md and config/simulation.yaml).
 struct SimulatorOptions {
   std::string environment;   // environment XML (set this, ~map_file or ~bitmap)
   std::string map_file;      // map_server yaml of a bitmap world

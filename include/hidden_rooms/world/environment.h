@@ -10,7 +10,7 @@
 
 namespace hidden_rooms {
 
-// The thesis's environment XML (KTH floor-plan schema, METHOD.md §10) as a metric model.
+// The thesis's environment XML (KTH floor-plan schema, docs/method.md#exploration-runs) as a metric model.
 //
 // Frame: the environment ("world") frame, metres, REP-103 (x right, y up). The XML stores image pixels
 // (x right, y down); a pixel (u, v) maps to (u * metres_per_pixel, (flip_v - v) * metres_per_pixel), where
@@ -97,13 +97,13 @@ void deriveDoors(Environment* environment, const std::string& source_name);
 std::string environmentToXml(const Environment& environment);
 void saveEnvironment(const Environment& environment, const std::string& path);
 
-// Door indices named by `spec`: "" = none, "all" = every door joining two spaces, "closable" = the closable
-// doors, else comma-separated door numbers or portal ids. Throws InputError (naming `source_name`) for a door that does not exist.
+// Door indices named by `spec`: "" = none, "all" = every door joining two spaces, "closable" = the closable doors, else
+// comma-separated door numbers or portal ids. Throws InputError (naming `source_name`) for a door that does not exist.
 std::set<int> parseDoorSelection(const Environment& environment, const std::string& spec,
                                  const std::string& source_name);
 
-// Doors whose only other side is a single space that has exactly this one door (METHOD.md §8): closing it
-// hides exactly that room. Returns door indices.
+// Doors whose only other side is a single space that has exactly this one door (docs/method.md#batch-analysis):
+// closing it hides exactly that room. Returns door indices.
 std::vector<int> closableDoors(const Environment& environment);
 
 // Index of the space behind a closable door (the space whose only door it is), or -1.

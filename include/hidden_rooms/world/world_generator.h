@@ -7,8 +7,8 @@
 
 namespace hidden_rooms {
 
-// Size classes by number of closable doors, as in the thesis (METHOD.md §8): small < 10, medium 10..15,
-// large >= 16.
+// Size classes by number of closable doors, as in the thesis (docs/method.md#batch-analysis): small < 10, medium
+// 10..15, large >= 16.
 enum class SizeClass { kSmall, kMedium, kLarge };
 
 SizeClass sizeClassOf(int closable_doors);
