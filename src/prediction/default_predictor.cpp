@@ -442,45 +442,48 @@ std::map<std::string, double> DefaultPredictor::defaultParameters() const {
 
 namespace {
 
-// The wall-fitted rectangle of every door (steps 1 to 3 of the header), in the map's frame; `angle` is the map's
-// dominantWallAngle, `map_states` its statesOf and `map_known` its known cells (255).
-std::vector<RoomPrediction> rectangleRooms(const PredictionRequest& request, const Parameters& P, double angle,
-                                           const cv::Mat1b& map_states, const cv::Mat1b& map_known) {
+// The image the rectangles are built in: the map's states, turned straight when the map is rotated.
+struct WorkingImage {
+  bool rotated = false;                   // the dominant wall angle is at least min_rotation
+  cv::Matx23d forward{1, 0, 0, 0, 1, 0};  // map pixel -> working pixel (identity unless rotated)
+  cv::Mat1b states;                       // statesOf the map in the working frame, kUnknownPx past the map
+};
+
+// Step 1, orientation: the map's states turned by -angle about their centre, on an image large enough for the
+// whole turned map (plus one pixel each side), when |angle| is at least min_rotation; else the states as they are.
+WorkingImage orientedStates(const cv::Mat1b& map_states, double angle, const Parameters& P) {
+  WorkingImage work;
+  work.rotated = std::abs(angle) * 180.0 / CV_PI >= P.min_rotation;
+  work.states = map_states;
+  if (!work.rotated) return work;
+  const double c = std::cos(-angle), s = std::sin(-angle);
+  const double w = map_states.cols, h = map_states.rows;
+  const int W = static_cast<int>(std::ceil(std::abs(c) * w + std::abs(s) * h)) + 2;
+  const int H = static_cast<int>(std::ceil(std::abs(s) * w + std::abs(c) * h)) + 2;
+  const cv::Point2d centre(w / 2.0, h / 2.0), new_centre(W / 2.0, H / 2.0);
+  work.forward = cv::Matx23d(c, -s, new_centre.x - (c * centre.x - s * centre.y), s, c,
+                             new_centre.y - (s * centre.x + c * centre.y));
+  cv::Mat1b rotated;
+  cv::warpAffine(map_states, rotated, cv::Mat(work.forward), cv::Size(W, H), cv::INTER_NEAREST, cv::BORDER_CONSTANT,
+                 cv::Scalar(kUnknownPx));
+  work.states = rotated;
+  return work;
+}
+
+// Step 2, extent: every door of the request in the working frame, placed on its wall (placeDoor) with its lateral
+// extent (lateralExtent); a door that cannot be placed keeps ok = false and its problem.
+std::vector<DoorFrame> framedDoors(const PredictionRequest& request, const Parameters& P, const WorkingImage& work,
+                                   const Frame& f) {
   const OccupancyGrid& map = request.map;
   const double resolution = map.resolution;
-
-  // 1. Orientation.
-  const bool rotate = std::abs(angle) * 180.0 / CV_PI >= P.min_rotation;
-  cv::Mat1b states = map_states;
-  cv::Matx23d forward(1, 0, 0, 0, 1, 0);
-  cv::Size work_size = states.size();
-  if (rotate) {
-    const double c = std::cos(-angle), s = std::sin(-angle);
-    const double w = states.cols, h = states.rows;
-    const int W = static_cast<int>(std::ceil(std::abs(c) * w + std::abs(s) * h)) + 2;
-    const int H = static_cast<int>(std::ceil(std::abs(s) * w + std::abs(c) * h)) + 2;
-    const cv::Point2d centre(w / 2.0, h / 2.0), new_centre(W / 2.0, H / 2.0);
-    forward = cv::Matx23d(c, -s, new_centre.x - (c * centre.x - s * centre.y), s, c,
-                          new_centre.y - (s * centre.x + c * centre.y));
-    work_size = cv::Size(W, H);
-    cv::Mat1b rotated;
-    cv::warpAffine(states, rotated, cv::Mat(forward), work_size, cv::INTER_NEAREST, cv::BORDER_CONSTANT,
-                   cv::Scalar(kUnknownPx));
-    states = rotated;
-  }
-  const Frame f(states, cv::boundingRect(states != kUnknownPx));
-
-  // 2. Doors.
-  const size_t count = request.doors.doors.size();
-  std::vector<DoorFrame> doors(count);
-  std::vector<std::string> problems(count);
-  for (size_t i = 0; i < count; ++i) {
+  std::vector<DoorFrame> doors(request.doors.doors.size());
+  for (size_t i = 0; i < doors.size(); ++i) {
     const MapDoor& door = request.doors.doors[i];
     DoorFrame& d = doors[i];
     cv::Point unused;
     if (!nearestUnknownCell(map, door.position, P.start_search_radius, &unused, &d.problem)) continue;
     const Point2 image = map.toImage(door.position);
-    const cv::Point2d q = applyAffine(forward, cv::Point2d(image.x(), image.y()));
+    const cv::Point2d q = applyAffine(work.forward, cv::Point2d(image.x(), image.y()));
     d.p = cv::Point(static_cast<int>(std::floor(q.x)), static_cast<int>(std::floor(q.y)));
     d.a = door.orientation == DoorOrientation::kAlongX ? cv::Point(1, 0) : cv::Point(0, 1);
     d.n = cv::Point(d.a.y, d.a.x);
@@ -490,20 +493,25 @@ std::vector<RoomPrediction> rectangleRooms(const PredictionRequest& request, con
     d.left = lateralExtent(f, resolution, P, &d, -1);
     d.right = lateralExtent(f, resolution, P, &d, +1);
   }
+  return doors;
+}
 
-  // Doors on the same wall and side share its extent: cut at the midpoints.
+// Step 2, extent (continued): doors on the same wall and side share its extent, cut at the midpoints between them.
+// Returns per door its siblings: the placed doors on its wall and side within its extent (before the cut).
+std::vector<std::vector<int>> splitSharedExtents(double resolution, std::vector<DoorFrame>* doors) {
   auto along = [](const DoorFrame& d, const cv::Point& q) { return d.a.x * q.x + d.a.y * q.y; };
   auto across = [](const DoorFrame& d, const cv::Point& q) { return d.n.x * q.x + d.n.y * q.y; };
   const int same_wall = std::max(2, static_cast<int>(0.6 / resolution));
+  const size_t count = doors->size();
   std::vector<std::vector<int>> siblings(count);
   for (size_t i = 0; i < count; ++i) {
-    if (!doors[i].ok) continue;
-    DoorFrame& d = doors[i];
+    if (!(*doors)[i].ok) continue;
+    DoorFrame& d = (*doors)[i];
     const int ci = along(d, d.p), wall_i = across(d, d.p) + d.s0;
     int left = d.left, right = d.right;
     for (size_t j = 0; j < count; ++j) {
-      if (j == i || !doors[j].ok) continue;
-      const DoorFrame& e = doors[j];
+      if (j == i || !(*doors)[j].ok) continue;
+      const DoorFrame& e = (*doors)[j];
       if (e.a != d.a || e.n != d.n) continue;
       if (std::abs(across(e, e.p) + e.s0 - wall_i) > same_wall) continue;
       const int offset = (along(e, e.p) - ci) * (d.a.x + d.a.y);  // u of the other door in d's frame
@@ -515,10 +523,17 @@ std::vector<RoomPrediction> rectangleRooms(const PredictionRequest& request, con
     d.left = left;
     d.right = right;
   }
-  for (size_t i = 0; i < count; ++i)
-    if (doors[i].ok) measureDepth(f, resolution, P, &doors[i]);
-  for (size_t i = 0; i < count; ++i) {
-    DoorFrame& d = doors[i];
+  return siblings;
+}
+
+// Step 2, depth: every placed door's depth, measured (measureDepth), else from the explored neighbours
+// (neighbourDepth), else the median of its bounded siblings, else the square prior; depth_source tells which.
+void measureDepths(const Frame& f, double resolution, const Parameters& P,
+                   const std::vector<std::vector<int>>& siblings, std::vector<DoorFrame>* doors) {
+  for (DoorFrame& d : *doors)
+    if (d.ok) measureDepth(f, resolution, P, &d);
+  for (size_t i = 0; i < doors->size(); ++i) {
+    DoorFrame& d = (*doors)[i];
     if (!d.ok || d.bounded) continue;
     double depth = neighbourDepth(f, resolution, P, d);
     d.depth_source = 1;
@@ -526,7 +541,7 @@ std::vector<RoomPrediction> rectangleRooms(const PredictionRequest& request, con
       d.depth_source = 2;
       std::vector<int> sibling_depths;
       for (int j : siblings[i])
-        if (doors[j].bounded) sibling_depths.push_back(doors[j].depth);
+        if ((*doors)[j].bounded) sibling_depths.push_back((*doors)[j].depth);
       if (!sibling_depths.empty()) depth = median(sibling_depths);
     }
     if (depth < 0) {
@@ -535,63 +550,83 @@ std::vector<RoomPrediction> rectangleRooms(const PredictionRequest& request, con
     }
     d.depth = static_cast<int>(std::lround(depth));
   }
+}
 
-  // Rectangles (working image, [x0, x1] x [y0, y1] inclusive); overlapping rooms are cut apart by an
-  // axis-aligned line halfway between their doors, across the axis along which the doors lie farther apart.
-  std::vector<cv::Rect> rects(count);
-  for (size_t i = 0; i < count; ++i) {
+// Per door its rectangle in the working image ([left, right] x [s0, s0 + depth] in the door's frame, inclusive);
+// empty for doors not placed.
+std::vector<cv::Rect> doorRectangles(const Frame& f, const std::vector<DoorFrame>& doors) {
+  std::vector<cv::Rect> rects(doors.size());
+  for (size_t i = 0; i < doors.size(); ++i) {
     const DoorFrame& d = doors[i];
     if (!d.ok) continue;
     const cv::Point c1 = f.at(d, d.left, d.s0), c2 = f.at(d, d.right, d.s0 + d.depth);
     rects[i] = cv::Rect(cv::Point(std::min(c1.x, c2.x), std::min(c1.y, c2.y)),
                         cv::Point(std::max(c1.x, c2.x) + 1, std::max(c1.y, c2.y) + 1));
   }
-  const int min_depth_px = std::max(1, static_cast<int>(std::lround(P.min_depth / resolution)));
-  for (size_t i = 0; i < count; ++i)
-    for (size_t j = i + 1; j < count; ++j) {
-      if (!doors[i].ok || !doors[j].ok || (rects[i] & rects[j]).area() == 0) continue;
+  return rects;
+}
+
+// Keeps the part of `r` in [lo, hi) along x (x_axis) or y; an empty range leaves an empty rectangle at lo.
+void keepRange(cv::Rect* r, int lo, int hi, bool x_axis) {
+  int a = x_axis ? r->x : r->y, b = x_axis ? r->x + r->width : r->y + r->height;
+  a = std::max(a, lo), b = std::min(b, hi);
+  if (b < a) b = a;
+  if (x_axis) r->x = a, r->width = b - a;
+  else r->y = a, r->height = b - a;
+}
+
+// Cuts two overlapping rectangles apart across x (cut_x) or y at the middle of their overlap, kept between the
+// doors' entry pixels pi and pj; false when the doors lie at the same coordinate along that axis.
+bool cutBetweenDoors(bool cut_x, const cv::Point& pi, const cv::Point& pj, cv::Rect* ri, cv::Rect* rj) {
+  const int ci = cut_x ? pi.x : pi.y, cj = cut_x ? pj.x : pj.y;
+  // The middle of the overlap, kept between the doors.
+  const int lo = std::max(cut_x ? ri->x : ri->y, cut_x ? rj->x : rj->y);
+  const int hi = std::min(cut_x ? ri->x + ri->width : ri->y + ri->height,
+                          cut_x ? rj->x + rj->width : rj->y + rj->height);
+  const int mid = std::clamp((lo + hi + 1) / 2, std::min(ci, cj) + 1, std::max(std::min(ci, cj) + 1, std::max(ci, cj)));
+  const int big = std::numeric_limits<int>::max() / 4;
+  keepRange(ri, ci < cj ? -big : mid, ci < cj ? mid : big, cut_x);
+  keepRange(rj, ci < cj ? mid : -big, ci < cj ? big : mid, cut_x);
+  return ci != cj;
+}
+
+// Step 2, overlap: every pair of overlapping rectangles (in index order) is separated. Doors on perpendicular
+// walls: the overlap goes to the door nearer to it (along that door's normal); the other room ends where the
+// overlap begins, when it keeps at least min_depth_px that way. Otherwise both cuts between the doors are tried
+// and the one keeping more of the two rooms wins (doors in line: only the cut between).
+void separateOverlaps(const Frame& f, const std::vector<DoorFrame>& doors, int min_depth_px,
+                      std::vector<cv::Rect>* rects) {
+  std::vector<cv::Rect>& r = *rects;
+  for (size_t i = 0; i < doors.size(); ++i)
+    for (size_t j = i + 1; j < doors.size(); ++j) {
+      if (!doors[i].ok || !doors[j].ok || (r[i] & r[j]).area() == 0) continue;
       const cv::Point pi = f.at(doors[i], 0, doors[i].s0), pj = f.at(doors[j], 0, doors[j].s0);
-      auto cut = [](cv::Rect* r, int lo, int hi, bool x_axis) {  // keep [lo, hi) along the axis
-        int a = x_axis ? r->x : r->y, b = x_axis ? r->x + r->width : r->y + r->height;
-        a = std::max(a, lo), b = std::min(b, hi);
-        if (b < a) b = a;
-        if (x_axis) r->x = a, r->width = b - a;
-        else r->y = a, r->height = b - a;
-      };
-      auto split = [&](bool cut_x, cv::Rect* ri, cv::Rect* rj) {
-        const int ci = cut_x ? pi.x : pi.y, cj = cut_x ? pj.x : pj.y;
-        // The middle of the overlap, kept between the doors.
-        const int lo = std::max(cut_x ? ri->x : ri->y, cut_x ? rj->x : rj->y);
-        const int hi = std::min(cut_x ? ri->x + ri->width : ri->y + ri->height,
-                                cut_x ? rj->x + rj->width : rj->y + rj->height);
-        const int mid = std::clamp((lo + hi + 1) / 2, std::min(ci, cj) + 1, std::max(std::min(ci, cj) + 1, std::max(ci, cj)));
-        const int big = std::numeric_limits<int>::max() / 4;
-        cut(ri, ci < cj ? -big : mid, ci < cj ? mid : big, cut_x);
-        cut(rj, ci < cj ? mid : -big, ci < cj ? big : mid, cut_x);
-        return ci != cj;
-      };
-      // Doors on perpendicular walls: the overlap goes to the door nearer to it (along that door's normal); the
-      // other room ends where the overlap begins, when it keeps at least the smallest depth that way.
       if ((doors[i].n.x != 0) != (doors[j].n.x != 0)) {
-        const cv::Rect overlap = rects[i] & rects[j];
+        const cv::Rect overlap = r[i] & r[j];
         const int gap_i = gapAlongNormal(doors[i], pi, overlap), gap_j = gapAlongNormal(doors[j], pj, overlap);
         const size_t farther = gap_i > gap_j ? i : j;
-        const cv::Rect shortened = endBefore(doors[farther], rects[farther], overlap);
+        const cv::Rect shortened = endBefore(doors[farther], r[farther], overlap);
         const int kept_depth = doors[farther].n.x != 0 ? shortened.width : shortened.height;
         if (gap_i != gap_j && kept_depth >= min_depth_px) {
-          rects[farther] = shortened;
+          r[farther] = shortened;
           continue;
         }
       }
-      // Both cuts are tried; the one keeping more of the two rooms wins (doors in line: only the cut between).
-      cv::Rect xi = rects[i], xj = rects[j], yi = rects[i], yj = rects[j];
-      const bool x_ok = split(true, &xi, &xj), y_ok = split(false, &yi, &yj);
+      cv::Rect xi = r[i], xj = r[j], yi = r[i], yj = r[j];
+      const bool x_ok = cutBetweenDoors(true, pi, pj, &xi, &xj), y_ok = cutBetweenDoors(false, pi, pj, &yi, &yj);
       const bool use_x = x_ok && (!y_ok || xi.area() + xj.area() >= yi.area() + yj.area());
-      rects[i] = use_x ? xi : yi;
-      rects[j] = use_x ? xj : yj;
+      r[i] = use_x ? xi : yi;
+      r[j] = use_x ? xj : yj;
     }
+}
 
-  // 3. Masks in the working frame; overlaps left go to the nearest door.
+// Step 3: per placed door the unknown pixels of its rectangle (working image), a pixel claimed by several rooms
+// going to the nearest door (the earlier one on a tie), then only the part 4-connected to the door's entry pixel
+// (all of it when that pixel is not the room's). Empty masks for doors not placed.
+std::vector<cv::Mat1b> roomMasks(const Frame& f, const std::vector<DoorFrame>& doors,
+                                 const std::vector<cv::Rect>& rects, const cv::Mat1b& states) {
+  const size_t count = doors.size();
+  const cv::Size work_size = states.size();
   std::vector<cv::Mat1b> masks(count);
   cv::Mat1s owner(work_size, static_cast<short>(-1));
   const cv::Mat1b unknown = states == kUnknownPx;
@@ -632,18 +667,27 @@ std::vector<RoomPrediction> rectangleRooms(const PredictionRequest& request, con
     cv::floodFill(in_rect, flood, seed - rect.tl(), 255, nullptr, 0, 0, 4 | cv::FLOODFILL_MASK_ONLY | (255 << 8));
     flood(cv::Rect(1, 1, rect.width, rect.height)).copyTo(in_rect);
   }
+  return masks;
+}
 
-  // Back to the map's frame.
+// The rooms in the map's frame, one per door of the request: the masks turned back (when the work image was
+// rotated) without the map's known cells (`map_known`, 255), with the rectangle's terms; unplaced doors get an
+// empty room with their problem.
+std::vector<RoomPrediction> mapFrameRooms(const PredictionRequest& request, const WorkingImage& work, double angle,
+                                          const std::vector<DoorFrame>& doors, const std::vector<cv::Rect>& rects,
+                                          const std::vector<cv::Mat1b>& masks, const cv::Mat1b& map_known) {
+  const OccupancyGrid& map = request.map;
+  const double resolution = map.resolution;
   std::vector<RoomPrediction> rooms;
-  for (size_t i = 0; i < count; ++i) {
+  for (size_t i = 0; i < doors.size(); ++i) {
     RoomPrediction room;
     room.door_id = request.doors.doors[i].id;
     room.problem = doors[i].problem;
     // Where the room's cells lie: its rectangle, or anywhere on a turned map.
     cv::Rect cells_within(0, 0, map.width(), map.height());
     if (doors[i].ok && !masks[i].empty()) {
-      if (rotate) {
-        cv::warpAffine(masks[i], room.mask, cv::Mat(forward), map.cells.size(),
+      if (work.rotated) {
+        cv::warpAffine(masks[i], room.mask, cv::Mat(work.forward), map.cells.size(),
                        cv::INTER_NEAREST | cv::WARP_INVERSE_MAP, cv::BORDER_CONSTANT, cv::Scalar(0));
       } else {
         room.mask = masks[i];
@@ -663,6 +707,22 @@ std::vector<RoomPrediction> rectangleRooms(const PredictionRequest& request, con
     rooms.push_back(std::move(room));
   }
   return rooms;
+}
+
+// The wall-fitted rectangle of every door (steps 1 to 3 of the header), in the map's frame; `angle` is the map's
+// dominantWallAngle, `map_states` its statesOf and `map_known` its known cells (255).
+std::vector<RoomPrediction> rectangleRooms(const PredictionRequest& request, const Parameters& P, double angle,
+                                           const cv::Mat1b& map_states, const cv::Mat1b& map_known) {
+  const double resolution = request.map.resolution;
+  const WorkingImage work = orientedStates(map_states, angle, P);
+  const Frame f(work.states, cv::boundingRect(work.states != kUnknownPx));
+  std::vector<DoorFrame> doors = framedDoors(request, P, work, f);
+  const std::vector<std::vector<int>> siblings = splitSharedExtents(resolution, &doors);
+  measureDepths(f, resolution, P, siblings, &doors);
+  std::vector<cv::Rect> rects = doorRectangles(f, doors);
+  separateOverlaps(f, doors, std::max(1, static_cast<int>(std::lround(P.min_depth / resolution))), &rects);
+  const std::vector<cv::Mat1b> masks = roomMasks(f, doors, rects, work.states);
+  return mapFrameRooms(request, work, angle, doors, rects, masks, map_known);
 }
 
 }  // namespace
