@@ -2,15 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
 #include <limits>
-#include <sstream>
 
 #include <opencv2/imgproc.hpp>
 
-#include "hidden_rooms/common/image_io.h"
 #include "hidden_rooms/common/input_error.h"
 #include "hidden_rooms/common/parameter_table.h"
+#include "hidden_rooms/prediction/layout_debug.h"
 
 namespace hidden_rooms {
 
@@ -637,174 +635,6 @@ std::vector<DoorStart> placeDoors(const OccupancyGrid& map, const std::vector<Ma
   return starts;
 }
 
-// ---------------------------------------------------------------------------------------------------------
-// Debug images
-
-cv::Scalar paletteColour(int k) {
-  cv::Mat3b hsv(1, 1, cv::Vec3b(static_cast<uint8_t>(std::fmod(k * 137.508, 360.0) / 2), 210, 225));
-  cv::Mat3b bgr;
-  cv::cvtColor(hsv, bgr, cv::COLOR_HSV2BGR);
-  return cv::Scalar(bgr(0, 0)[0], bgr(0, 0)[1], bgr(0, 0)[2]);
-}
-
-// A canvas covering the image and the cell grid, with the map drawn at its place.
-class DebugCanvas {
- public:
-  DebugCanvas(const Layout& layout, const cv::Mat1b& grey) : grey_(grey) {
-    cv::Rect bounds(cv::Point(0, 0), layout.image_size);
-    const CellGrid& grid = layout.grid;
-    if (grid.columns() > 0 && grid.rows() > 0)
-      bounds |= cv::Rect(cv::Point(grid.xs.front(), grid.ys.front()),
-                         cv::Point(grid.xs.back() + 1, grid.ys.back() + 1));
-    offset_ = -bounds.tl();
-    size_ = bounds.size();
-  }
-
-  // The map in colour, faded towards white by `fade` in [0, 1]; the area past the image is unknown grey.
-  cv::Mat3b map(double fade = 0.0) const {
-    cv::Mat3b canvas(size_, cv::Vec3b(205, 205, 205));
-    cv::Mat3b colour;
-    cv::cvtColor(grey_, colour, cv::COLOR_GRAY2BGR);
-    colour.copyTo(canvas(cv::Rect(offset_, grey_.size())));
-    if (fade > 0) canvas = canvas * (1.0 - fade) + cv::Scalar::all(255 * fade);
-    return canvas;
-  }
-
-  cv::Point at(const Point2& p) const {
-    return cv::Point(static_cast<int>(std::lround(p.x())), static_cast<int>(std::lround(p.y()))) + offset_;
-  }
-  cv::Rect at(const cv::Rect& r) const { return cv::Rect(r.tl() + offset_, r.size()) & cv::Rect(cv::Point(), size_); }
-  cv::Size size() const { return size_; }
-
-  // Occupied pixels of the map drawn black over `canvas`.
-  void drawWalls(cv::Mat3b* canvas) const {
-    (*canvas)(cv::Rect(offset_, grey_.size())).setTo(cv::Scalar::all(0), grey_ == 0);
-  }
-
-  void drawGridLines(const Layout& layout, cv::Mat3b* canvas, const cv::Scalar& colour) const {
-    const CellGrid& grid = layout.grid;
-    if (grid.columns() == 0 || grid.rows() == 0) return;
-    for (int x : grid.xs) cv::line(*canvas, at(Point2(x, grid.ys.front())), at(Point2(x, grid.ys.back())), colour, 1);
-    for (int y : grid.ys) cv::line(*canvas, at(Point2(grid.xs.front(), y)), at(Point2(grid.xs.back(), y)), colour, 1);
-  }
-
- private:
-  cv::Mat1b grey_;
-  cv::Point offset_;
-  cv::Size size_;
-};
-
-void writeImage(const std::string& dir, const std::string& name, const cv::Mat& image) {
-  const std::string path = (std::filesystem::path(dir) / name).string();
-  hidden_rooms::writeImage(path, image);
-}
-
-void blend(cv::Mat3b* canvas, const cv::Rect& rect, const cv::Scalar& colour, double alpha) {
-  if (rect.area() <= 0) return;
-  cv::Mat3b region = (*canvas)(rect);
-  cv::Mat3b tint(region.size(), cv::Vec3b(colour[0], colour[1], colour[2]));
-  cv::addWeighted(region, 1.0 - alpha, tint, alpha, 0.0, region);
-}
-
-void writeDebugImages(const std::string& dir, const OccupancyGrid& map, const std::vector<MapDoor>& doors,
-                      const cv::Mat1b& grey, const cv::Mat1b& edges, const Layout& layout) {
-  std::error_code error;
-  std::filesystem::create_directories(dir, error);
-  if (!std::filesystem::is_directory(dir)) throw InputError(dir, "cannot create debug folder");
-
-  const DebugCanvas canvas(layout, grey);
-  writeImage(dir, "edges.png", edges);
-
-  cv::Mat3b segments = canvas.map(0.5);
-  for (const ImageSegment& s : layout.segments)
-    cv::line(segments, canvas.at(s.a), canvas.at(s.b), cv::Scalar(0, 0, 255), 1);
-  writeImage(dir, "segments.png", segments);
-
-  cv::Mat3b angular = canvas.map(0.7);
-  for (size_t s = 0; s < layout.segments.size(); ++s)
-    cv::line(angular, canvas.at(layout.segments[s].a), canvas.at(layout.segments[s].b),
-             paletteColour(layout.segment_angular_cluster[s]), 2);
-  for (int m = 0; m < static_cast<int>(layout.angular_modes.size()); ++m) {
-    double degrees = layout.angular_modes[m] * 180.0 / CV_PI;  // shown in [-45, 135): 179.9 as -0.1
-    if (degrees >= 135.0) degrees -= 180.0;
-    cv::putText(angular, formatNumber(std::round(degrees * 10) / 10 + 0.0) + " deg", cv::Point(5, 15 + 15 * m),
-                cv::FONT_HERSHEY_SIMPLEX, 0.4, paletteColour(m), 1);
-  }
-  writeImage(dir, "angular_clusters.png", angular);
-
-  cv::Mat3b walls = canvas.map(0.7);
-  for (size_t w = 0; w < layout.walls.size(); ++w) {
-    const cv::Scalar colour = paletteColour(static_cast<int>(w));
-    for (int s : layout.walls[w].segments)
-      cv::line(walls, canvas.at(layout.segments[s].a), canvas.at(layout.segments[s].b),
-               colour * 0.5 + cv::Scalar::all(127), 1);
-    cv::line(walls, canvas.at(layout.walls[w].segment.a), canvas.at(layout.walls[w].segment.b), colour, 2);
-  }
-  writeImage(dir, "walls.png", walls);
-
-  const CellGrid& grid = layout.grid;
-  const bool has_grid = grid.columns() > 0 && grid.rows() > 0;
-  cv::Mat3b lines = canvas.map(0.5);
-  if (has_grid)
-    for (const ExtendedLine& line : layout.lines) {
-      const cv::Scalar colour = line.source == LineSource::kWall       ? cv::Scalar(200, 80, 0)
-                                : line.source == LineSource::kDoorPair ? cv::Scalar(200, 0, 200)
-                                                                       : cv::Scalar(0, 160, 0);
-      const bool horizontal = line.axis == LineAxis::kHorizontal;
-      const Point2 a = horizontal ? Point2(grid.xs.front(), line.position) : Point2(line.position, grid.ys.front());
-      const Point2 b = horizontal ? Point2(grid.xs.back(), line.position) : Point2(line.position, grid.ys.back());
-      cv::line(lines, canvas.at(a), canvas.at(b), colour, 1);
-    }
-  for (const MapDoor& door : doors)
-    cv::circle(lines, canvas.at(map.toImage(door.position)), 4, cv::Scalar(0, 0, 255), 2);
-  cv::putText(lines, "wall", cv::Point(5, 15), cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(200, 80, 0), 1);
-  cv::putText(lines, "door pair", cv::Point(5, 30), cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(200, 0, 200), 1);
-  cv::putText(lines, "boundary", cv::Point(5, 45), cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(0, 160, 0), 1);
-  writeImage(dir, "extended_lines.png", lines);
-
-  // Cells: IN white, OUT grey, border cells tinted orange; the map's walls in black; grid lines light blue;
-  // the faded map past the grid.
-  cv::Mat3b cells = canvas.map(0.6);
-  for (const LayoutCell& cell : grid.cells) {
-    const cv::Rect rect = canvas.at(cell.rect);
-    cells(rect).setTo(cell.out ? cv::Scalar::all(150) : cv::Scalar::all(255));
-    if (cell.border) blend(&cells, rect, cv::Scalar(0, 140, 255), 0.35);
-  }
-  canvas.drawWalls(&cells);
-  canvas.drawGridLines(layout, &cells, cv::Scalar(230, 190, 120));
-  writeImage(dir, "cells.png", cells);
-
-  // Rooms: IN cells coloured by room, OUT cells grey (border cells darker).
-  cv::Mat3b rooms = canvas.map(0.6);
-  for (const LayoutCell& cell : grid.cells) {
-    const cv::Rect rect = canvas.at(cell.rect);
-    rooms(rect).setTo(!cell.out     ? paletteColour(cell.room) * 0.6 + cv::Scalar::all(100)
-                      : cell.border ? cv::Scalar::all(120)
-                                    : cv::Scalar::all(150));
-  }
-  canvas.drawWalls(&rooms);
-  canvas.drawGridLines(layout, &rooms, cv::Scalar(90, 90, 90));
-  writeImage(dir, "rooms.png", rooms);
-
-  cv::Mat3b starts = canvas.map(0.3);
-  canvas.drawGridLines(layout, &starts, cv::Scalar(230, 190, 120));
-  for (size_t d = 0; d < layout.doors.size() && d < doors.size(); ++d) {
-    const DoorStart& start = layout.doors[d];
-    const cv::Point door = canvas.at(map.toImage(doors[d].position));
-    const cv::Scalar colour = paletteColour(static_cast<int>(d));
-    if (start.found) {
-      blend(&starts, canvas.at(grid.cells[start.start_cell].rect), colour, 0.5);
-      cv::line(starts, canvas.at(start.edge.a), canvas.at(start.edge.b), cv::Scalar(0, 0, 255), 3);
-      cv::circle(starts, door, 4, cv::Scalar(0, 0, 0), 2);
-    } else {
-      cv::drawMarker(starts, door, cv::Scalar(0, 0, 255), cv::MARKER_TILTED_CROSS, 12, 2);
-    }
-    cv::putText(starts, std::to_string(doors[d].id), door + cv::Point(6, -6), cv::FONT_HERSHEY_SIMPLEX, 0.5,
-                cv::Scalar(0, 0, 0), 2);
-  }
-  writeImage(dir, "start_cells.png", starts);
-}
-
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------------------
@@ -893,7 +723,7 @@ Layout analyzeLayout(const OccupancyGrid& map, const std::vector<MapDoor>& close
   layout.room_count = segmentRooms(options, &layout.grid);
   layout.doors = placeDoors(map, closed_doors, options, layout.grid);
 
-  if (!debug_dir.empty()) writeDebugImages(debug_dir, map, closed_doors, grey, edges, layout);
+  if (!debug_dir.empty()) writeLayoutDebugImages(debug_dir, map, closed_doors, grey, edges, layout);
   return layout;
 }
 
