@@ -105,14 +105,7 @@ ExplorerOptions readExplorerOptions(const ros::NodeHandle& nh) {
 }
 
 Explorer::Explorer(ros::NodeHandle nh, const ExplorerOptions& options)
-    : options_(options),
-      planner_(options.planner),
-      follower_(options.follower),
-      passages_(options.passages),
-      tf_buffer_(ros::Duration(10.0)),
-      tf_listener_(tf_buffer_),
-      obstacle_memory_(options.obstacle_memory) {
-  blacklist_.radius = options.blacklist_radius;
+    : options_(options), policy_(options), tf_buffer_(ros::Duration(10.0)), tf_listener_(tf_buffer_) {
   map_subscriber_ = nh.subscribe("map", 1, &Explorer::onMap, this);
   scan_subscriber_ = nh.subscribe("base_scan", 1, &Explorer::onScan, this);
   command_publisher_ = nh.advertise<geometry_msgs::Twist>("cmd_vel", 1);
@@ -130,7 +123,11 @@ void Explorer::onMap(const nav_msgs::OccupancyGrid::ConstPtr& map) {
   }
   latest_map_ = map;
   map_received_ = ros::Time::now();
-  map_changed_ = true;
+  try {
+    policy_.setMap(fromRos(*map));
+  } catch (const InputError& error) {
+    policy_.setUnusableMap(error.what());  // reported when the policy plans with it
+  }
 }
 
 void Explorer::onScan(const sensor_msgs::LaserScan::ConstPtr& scan) {
@@ -176,7 +173,7 @@ bool Explorer::robotPose(Pose2* pose) {
 }
 
 void Explorer::holdRobot(const ros::Time& now) {
-  follower_.hold(now.toSec());
+  policy_.hold(now.toSec());
   publishCommand(VelocityCommand());
 }
 
@@ -203,7 +200,7 @@ void Explorer::onTimer(const ros::TimerEvent&) {
   if (map_received_.isZero()) map_received_ = now;
   const double map_age = (now - map_received_).toSec();
   if (options_.map_timeout > 0.0 && map_age > options_.map_timeout) {
-    if (!done_)
+    if (!policy_.done())
       ROS_WARN_THROTTLE(5.0, "explorer: no new map on %s for %.1f s (mapper down?); stopped until one comes",
                         map_subscriber_.getTopic().c_str(), map_age);
     map_stale_ = true;
@@ -215,154 +212,81 @@ void Explorer::onTimer(const ros::TimerEvent&) {
     map_stale_ = false;
   }
 
-  // The follower sees the latest scan and the remembered ones (placed with the robot's current pose).
+  // The latest scan is remembered with the robot's current pose.
   if (!scan_remembered_) {
-    obstacle_memory_.add(scan_points_, pose, now.toSec());
+    policy_.addScan(scan_points_, pose, now.toSec());
     scan_remembered_ = true;
   }
-  const std::vector<Point2> obstacles = obstacle_memory_.points(pose);
+  const ExplorationStep step = policy_.update(pose, now.toSec());
+  report(step, now);
+  if (step.planned) publishMarkers(now);
+  publishCommand(step.command);
+}
 
-  // Replan on a new map, every replan_interval, and when the follower has nothing to do; recovery manoeuvres
-  // run to their end first.
-  const FollowerState state = follower_.state();
-  const bool recovering = state == FollowerState::kBackingOff || state == FollowerState::kRecoveryRotating;
-  const bool replan_due = options_.replan_interval > 0.0 && (now - last_plan_).toSec() >= options_.replan_interval;
-  if (!recovering && (map_changed_ || replan_due)) plan(pose, now);
-
-  if (goal_) {
-    const FollowerStep step = follower_.update(pose, obstacles, now.toSec());
-    if (step.state != FollowerState::kGoalReached && step.state != FollowerState::kFailed) {
-      publishCommand(step.command);
-      return;
-    }
-    // A reached goal whose frontier is still there next time cannot be seen from there: no goal near it again.
-    // A failed one gets one more try when nothing else is left; one failed because the robot could not move at
-    // all (no recovery moved it), a try each time nothing else is left.
-    const bool robot_stuck = step.state == FollowerState::kFailed && follower_.recoveries() > 0 &&
-                             follower_.recoveriesWithoutMotion() == follower_.recoveries();
-    const bool released_later =
-        blacklist_.add(goal_->position, step.state == FollowerState::kGoalReached ? GoalOutcome::kReached
-                                        : robot_stuck                            ? GoalOutcome::kRobotStuck
-                                                                                 : GoalOutcome::kFailed);
-    if (robot_stuck)
-      ROS_WARN("explorer: goal (%.2f, %.2f) failed: the robot did not move in %d recoveries (stuck?); "
-               "blacklisted until no other goal is left", goal_->position.x(), goal_->position.y(),
-               follower_.recoveries());
-    else if (step.state == FollowerState::kFailed)
-      ROS_WARN("explorer: goal (%.2f, %.2f) not reached (%d recoveries, no progress); blacklisted (%s)",
-               goal_->position.x(), goal_->position.y(), follower_.recoveries(),
-               released_later ? "a second try when no other goal is left" : "it failed there on its second try");
-    const size_t blocked_before = passages_.blockedPoints().size();
-    if (step.state == FollowerState::kFailed && !robot_stuck &&
-        passages_.addFailure(Point2(pose.x, pose.y), follower_.path())) {
-      planner_.setBlockedPoints(passages_.blockedPoints(), options_.passages.radius);
-      if (passages_.blockedPoints().size() > blocked_before)
+void Explorer::report(const ExplorationStep& step, const ros::Time& now) {
+  for (const ExplorationEvent& event : step.events) {
+    const double x = event.position.x(), y = event.position.y();
+    switch (event.type) {
+      case ExplorationEventType::kMapUnusable:
+        ROS_WARN_THROTTLE(5.0, "explorer: unusable map: %s", event.message.c_str());
+        break;
+      case ExplorationEventType::kStartBlocked:
+        ROS_WARN_THROTTLE(5.0, "explorer: robot at (%.2f, %.2f) is not within %.2f m of a traversable map cell; "
+                          "waiting for the map (or a recovery) to free it", x, y,
+                          options_.planner.start_escape_radius);
+        break;
+      case ExplorationEventType::kGoalChosen:
+        ++goals_chosen_;
+        ROS_DEBUG("explorer: goal (%.2f, %.2f), path %.2f m, cost %.2f", x, y, event.path_length, event.cost);
+        break;
+      case ExplorationEventType::kGoalReached:
+        break;
+      case ExplorationEventType::kGoalFailedStuck:
+        ROS_WARN("explorer: goal (%.2f, %.2f) failed: the robot did not move in %d recoveries (stuck?); "
+                 "blacklisted until no other goal is left", x, y, event.recoveries);
+        break;
+      case ExplorationEventType::kGoalFailed:
+        ROS_WARN("explorer: goal (%.2f, %.2f) not reached (%d recoveries, no progress); blacklisted (%s)", x, y,
+                 event.recoveries,
+                 event.retry_later ? "a second try when no other goal is left" : "it failed there on its second try");
+        break;
+      case ExplorationEventType::kPassageBlocked:
         ROS_WARN("explorer: %d goals failed from (%.2f, %.2f) in one direction: the path ahead is blocked for the "
-                 "planner", options_.passages.failures, pose.x, pose.y);
-      else
+                 "planner", options_.passages.failures, x, y);
+        break;
+      case ExplorationEventType::kPassageOpened:
         ROS_WARN("explorer: goals failed from (%.2f, %.2f) in different directions: the robot is stuck there, not "
-                 "a passage ahead; opened again", pose.x, pose.y);
-    }
-    goal_.reset();
-    plan(pose, now);
-    if (goal_) {
-      publishCommand(follower_.update(pose, obstacles, now.toSec()).command);
-      return;
-    }
-  }
-  // No goal: turn in place to look around until a frontier shows up or done is confirmed.
-  VelocityCommand look_around;
-  if (!done_) look_around.angular = options_.search_angular_velocity;
-  publishCommand(look_around);
-}
-
-void Explorer::plan(const Pose2& pose, const ros::Time& now) {
-  last_plan_ = now;
-  const bool new_map = map_changed_;
-  if (map_changed_) {
-    try {
-      planner_.setMap(fromRos(*latest_map_));
-    } catch (const InputError& error) {
-      ROS_WARN_THROTTLE(5.0, "explorer: unusable map: %s", error.what());
-      map_changed_ = false;
-      return;
-    }
-    map_changed_ = false;
-  }
-  const FrontierMap frontiers = findFrontiers(planner_.map(), options_.frontiers);
-  if (!planner_.computeCostsFrom(Point2(pose.x, pose.y))) {
-    ROS_WARN_THROTTLE(5.0, "explorer: robot at (%.2f, %.2f) is not within %.2f m of a traversable map cell; "
-                      "waiting for the map (or a recovery) to free it", pose.x, pose.y,
-                      options_.planner.start_escape_radius);
-    publishMarkers(frontiers, now);
-    return;
-  }
-  const std::optional<Point2> previous =
-      goal_ && follower_.state() == FollowerState::kFollowing ? std::optional<Point2>(goal_->position) : std::nullopt;
-  // The nearest goal with the current blacklist and costs (tried again after each release below).
-  const auto nearest = [&] {
-    return nearestFrontierGoal(frontiers, planner_, blacklist_, options_.frontiers, previous, options_.goal_hysteresis);
-  };
-  std::optional<FrontierGoal> goal = nearest();
-  if (!goal && !blacklist_.stuck_points.empty()) {
-    // Not done while the only goals left failed because the robot could not move: try them again (their
-    // recoveries are what may free the robot).
-    ROS_WARN("explorer: no other goal; %zu goals failed while the robot could not move: trying them again",
-             blacklist_.releaseStuck());
-    goal = nearest();
-  }
-  if (!goal) {
-    const size_t unblocked = passages_.releaseOnce();
-    if (unblocked > 0) {
-      // A passage may have been blocked by failures with another cause: before done, each is tried once more.
-      ROS_WARN("explorer: no other goal; opening the blocked passages again (%zu points, once)", unblocked);
-      planner_.setBlockedPoints({}, 0.0);
-      if (planner_.computeCostsFrom(Point2(pose.x, pose.y)))
-        goal = nearest();
+                 "a passage ahead; opened again", x, y);
+        break;
+      case ExplorationEventType::kStuckReleased:
+        ROS_WARN("explorer: no other goal; %zu goals failed while the robot could not move: trying them again",
+                 event.count);
+        break;
+      case ExplorationEventType::kPassagesReleased:
+        ROS_WARN("explorer: no other goal; opening the blocked passages again (%zu points, once)", event.count);
+        break;
+      case ExplorationEventType::kFailedReleased:
+        ROS_WARN("explorer: no other goal; %zu failed goals get their second try", event.count);
+        break;
+      case ExplorationEventType::kNoGoal:
+        ROS_INFO("explorer: no reachable frontier (%zu frontiers, %zu blacklisted places); checking again",
+                 event.count, event.blacklisted);
+        break;
+      case ExplorationEventType::kDone:
+      case ExplorationEventType::kResumed: {
+        const bool done = event.type == ExplorationEventType::kDone;
+        std_msgs::Bool message;
+        message.data = done;
+        done_publisher_.publish(message);
+        if (done)
+          ROS_INFO("explorer: exploration done: no reachable frontier left (t = %.1f s, %.1f m driven, %d goals, "
+                   "%zu blacklisted places)", now.toSec(), distance_driven_, goals_chosen_, event.blacklisted);
+        else
+          ROS_INFO("explorer: a reachable frontier appeared; exploring again");
+        break;
+      }
     }
   }
-  if (!goal && !blacklist_.failed_points.empty()) {
-    ROS_WARN("explorer: no other goal; %zu failed goals get their second try", blacklist_.releaseFailed());
-    goal = nearest();
-  }
-  if (!goal) {
-    goal_.reset();
-    follower_.stop();
-    // Only plans on new maps count towards done (the map must have had the chance to change).
-    if (new_map) ++plans_without_goal_;
-    if (plans_without_goal_ >= options_.done_confirmations && !done_) setDone(true, now);
-    if (!done_)
-      ROS_INFO("explorer: no reachable frontier (%zu frontiers, %zu blacklisted places); checking again",
-               frontiers.frontiers.size(), blacklist_.points.size());
-    publishMarkers(frontiers, now);
-    return;
-  }
-  plans_without_goal_ = 0;
-  if (done_) setDone(false, now);
-  std::vector<Point2> path = planner_.pathTo(goal->cell.x, goal->cell.y);
-  const bool same_goal = goal_ && (goal_->position - goal->position).norm() < 1e-6;
-  if (same_goal && follower_.state() == FollowerState::kFollowing) {
-    follower_.updatePath(path);
-  } else {
-    follower_.setPath(path, now.toSec());
-    ++goals_chosen_;
-    ROS_DEBUG("explorer: goal (%.2f, %.2f), path %.2f m, cost %.2f", goal->position.x(), goal->position.y(),
-              pathLength(path), goal->cost);
-  }
-  goal_ = goal;
-  publishMarkers(frontiers, now);
-}
-
-void Explorer::setDone(bool done, const ros::Time& now) {
-  done_ = done;
-  std_msgs::Bool message;
-  message.data = done;
-  done_publisher_.publish(message);
-  if (done)
-    ROS_INFO("explorer: exploration done: no reachable frontier left (t = %.1f s, %.1f m driven, %d goals, "
-             "%zu blacklisted places)", now.toSec(), distance_driven_, goals_chosen_, blacklist_.points.size());
-  else
-    ROS_INFO("explorer: a reachable frontier appeared; exploring again");
 }
 
 void Explorer::publishCommand(const VelocityCommand& command) {
@@ -372,19 +296,19 @@ void Explorer::publishCommand(const VelocityCommand& command) {
   command_publisher_.publish(toRos(command));
 }
 
-void Explorer::publishMarkers(const FrontierMap& frontiers, const ros::Time& now) {
+void Explorer::publishMarkers(const ros::Time& now) {
   if (markers_publisher_.getNumSubscribers() == 0) return;
   ExplorationView view;
-  view.frontiers = &frontiers;
-  if (goal_) {
-    view.goal_frontier_label = goal_->frontier_label;
-    view.goal = goal_->position;
-    view.path = follower_.path();
+  view.frontiers = &policy_.frontiers();
+  if (policy_.goal()) {
+    view.goal_frontier_label = policy_.goal()->frontier_label;
+    view.goal = policy_.goal()->position;
+    view.path = policy_.follower().path();
   }
-  view.blacklist = blacklist_.points;
-  view.blocked_passages = passages_.blockedPoints();
+  view.blacklist = policy_.blacklist().points;
+  view.blocked_passages = policy_.passages().blockedPoints();
   view.blocked_passage_radius = options_.passages.radius;
-  markers_publisher_.publish(toMarkers(planner_.map(), view, options_.map_frame, now));
+  markers_publisher_.publish(toMarkers(policy_.planner().map(), view, options_.map_frame, now));
 }
 
 }  // namespace hidden_rooms

@@ -1,0 +1,193 @@
+#include "hidden_rooms/exploration/exploration_policy.h"
+
+namespace hidden_rooms {
+
+namespace {
+
+// Half ROS time's resolution: time differences closer than this to a threshold reach it.
+constexpr double kTimeEpsilon = 0.5e-9;
+
+ExplorationEvent event(ExplorationEventType type, const Point2& position = Point2::Zero(), size_t count = 0) {
+  ExplorationEvent result;
+  result.type = type;
+  result.position = position;
+  result.count = count;
+  return result;
+}
+
+}  // namespace
+
+ExplorationPolicy::ExplorationPolicy(const ExplorationPolicyOptions& options)
+    : options_(options),
+      planner_(options.planner),
+      follower_(options.follower),
+      passages_(options.passages),
+      obstacle_memory_(options.obstacle_memory) {
+  blacklist_.radius = options.blacklist_radius;
+}
+
+void ExplorationPolicy::setMap(const OccupancyGrid& map) {
+  next_map_ = map;
+  pending_map_ = PendingMap::kUsable;
+}
+
+void ExplorationPolicy::setUnusableMap(const std::string& reason) {
+  next_map_ = OccupancyGrid();
+  unusable_reason_ = reason;
+  pending_map_ = PendingMap::kUnusable;
+}
+
+void ExplorationPolicy::addScan(const std::vector<Point2>& points, const Pose2& pose, double time) {
+  obstacle_memory_.add(points, pose, time);
+}
+
+void ExplorationPolicy::hold(double time) { follower_.hold(time); }
+
+ExplorationStep ExplorationPolicy::update(const Pose2& pose, double time) {
+  ExplorationStep step;
+  // The follower sees the latest scan and the remembered ones (placed with the robot's current pose).
+  const std::vector<Point2> obstacles = obstacle_memory_.points(pose);
+
+  // Replan on a new map, every replan_interval, and when the follower has nothing to do; recovery manoeuvres
+  // run to their end first.
+  const FollowerState state = follower_.state();
+  const bool recovering = state == FollowerState::kBackingOff || state == FollowerState::kRecoveryRotating;
+  const bool replan_due =
+      options_.replan_interval > 0.0 && time - last_plan_ >= options_.replan_interval - kTimeEpsilon;
+  if (!recovering && (pending_map_ != PendingMap::kNone || replan_due)) plan(pose, time, &step);
+
+  if (goal_) {
+    const FollowerStep followed = follower_.update(pose, obstacles, time);
+    if (followed.state != FollowerState::kGoalReached && followed.state != FollowerState::kFailed) {
+      step.command = followed.command;
+      return step;
+    }
+    finishGoal(pose, followed.state, &step);
+    plan(pose, time, &step);
+    if (goal_) {
+      step.command = follower_.update(pose, obstacles, time).command;
+      return step;
+    }
+  }
+  // No goal: turn in place to look around until a frontier shows up or done is confirmed.
+  if (!done_) step.command.angular = options_.search_angular_velocity;
+  return step;
+}
+
+void ExplorationPolicy::finishGoal(const Pose2& pose, FollowerState outcome, ExplorationStep* step) {
+  // A reached goal whose frontier is still there next time cannot be seen from there: no goal near it again.
+  // A failed one gets one more try when nothing else is left; one failed because the robot could not move at
+  // all (no recovery moved it), a try each time nothing else is left.
+  const bool failed = outcome == FollowerState::kFailed;
+  const bool robot_stuck =
+      failed && follower_.recoveries() > 0 && follower_.recoveriesWithoutMotion() == follower_.recoveries();
+  const bool released_later = blacklist_.add(goal_->position, !failed      ? GoalOutcome::kReached
+                                                              : robot_stuck ? GoalOutcome::kRobotStuck
+                                                                            : GoalOutcome::kFailed);
+  ExplorationEvent ended = event(!failed      ? ExplorationEventType::kGoalReached
+                                 : robot_stuck ? ExplorationEventType::kGoalFailedStuck
+                                               : ExplorationEventType::kGoalFailed,
+                                 goal_->position);
+  ended.recoveries = follower_.recoveries();
+  ended.retry_later = failed && !robot_stuck && released_later;
+  step->events.push_back(ended);
+
+  const size_t blocked_before = passages_.blockedPoints().size();
+  const Point2 robot(pose.x, pose.y);
+  if (failed && !robot_stuck && passages_.addFailure(robot, follower_.path())) {
+    planner_.setBlockedPoints(passages_.blockedPoints(), options_.passages.radius);
+    step->events.push_back(event(passages_.blockedPoints().size() > blocked_before
+                                     ? ExplorationEventType::kPassageBlocked
+                                     : ExplorationEventType::kPassageOpened,
+                                 robot));
+  }
+  goal_.reset();
+}
+
+void ExplorationPolicy::plan(const Pose2& pose, double time, ExplorationStep* step) {
+  last_plan_ = time;
+  const PendingMap pending = pending_map_;
+  pending_map_ = PendingMap::kNone;
+  if (pending == PendingMap::kUnusable) {
+    ExplorationEvent unusable = event(ExplorationEventType::kMapUnusable);
+    unusable.message = unusable_reason_;
+    step->events.push_back(unusable);
+    return;
+  }
+  const bool new_map = pending == PendingMap::kUsable;
+  if (new_map) {
+    planner_.setMap(next_map_);
+    next_map_ = OccupancyGrid();
+  }
+  const Point2 robot(pose.x, pose.y);
+  frontiers_ = findFrontiers(planner_.map(), options_.frontiers);
+  step->planned = true;
+  if (!planner_.computeCostsFrom(robot)) {
+    step->events.push_back(event(ExplorationEventType::kStartBlocked, robot));
+    return;
+  }
+  const std::optional<Point2> previous =
+      goal_ && follower_.state() == FollowerState::kFollowing ? std::optional<Point2>(goal_->position) : std::nullopt;
+  // The nearest goal with the current blacklist and costs (tried again after each release below).
+  const auto nearest = [&] {
+    return nearestFrontierGoal(frontiers_, planner_, blacklist_, options_.frontiers, previous,
+                               options_.goal_hysteresis);
+  };
+  std::optional<FrontierGoal> goal = nearest();
+  if (!goal && !blacklist_.stuck_points.empty()) {
+    // Not done while the only goals left failed because the robot could not move: try them again (their
+    // recoveries are what may free the robot).
+    step->events.push_back(event(ExplorationEventType::kStuckReleased, robot, blacklist_.releaseStuck()));
+    goal = nearest();
+  }
+  if (!goal) {
+    const size_t unblocked = passages_.releaseOnce();
+    if (unblocked > 0) {
+      // A passage may have been blocked by failures with another cause: before done, each is tried once more.
+      step->events.push_back(event(ExplorationEventType::kPassagesReleased, robot, unblocked));
+      planner_.setBlockedPoints({}, 0.0);
+      if (planner_.computeCostsFrom(robot)) goal = nearest();
+    }
+  }
+  if (!goal && !blacklist_.failed_points.empty()) {
+    step->events.push_back(event(ExplorationEventType::kFailedReleased, robot, blacklist_.releaseFailed()));
+    goal = nearest();
+  }
+  if (!goal) {
+    goal_.reset();
+    follower_.stop();
+    // Only plans on new maps count towards done (the map must have had the chance to change).
+    if (new_map) ++plans_without_goal_;
+    if (plans_without_goal_ >= options_.done_confirmations && !done_) {
+      done_ = true;
+      ExplorationEvent finished = event(ExplorationEventType::kDone, robot);
+      finished.blacklisted = blacklist_.points.size();
+      step->events.push_back(finished);
+    }
+    if (!done_) {
+      ExplorationEvent none = event(ExplorationEventType::kNoGoal, robot, frontiers_.frontiers.size());
+      none.blacklisted = blacklist_.points.size();
+      step->events.push_back(none);
+    }
+    return;
+  }
+  plans_without_goal_ = 0;
+  if (done_) {
+    done_ = false;
+    step->events.push_back(event(ExplorationEventType::kResumed, robot));
+  }
+  const std::vector<Point2> path = planner_.pathTo(goal->cell.x, goal->cell.y);
+  const bool same_goal = goal_ && (goal_->position - goal->position).norm() < 1e-6;
+  if (same_goal && follower_.state() == FollowerState::kFollowing) {
+    follower_.updatePath(path);
+  } else {
+    follower_.setPath(path, time);
+    ExplorationEvent chosen = event(ExplorationEventType::kGoalChosen, goal->position);
+    chosen.cost = goal->cost;
+    chosen.path_length = pathLength(path);
+    step->events.push_back(chosen);
+  }
+  goal_ = goal;
+}
+
+}  // namespace hidden_rooms
