@@ -157,11 +157,11 @@ std::string corridorWithTwoRoomsXml(const std::string& door1_status, const std::
          corridor + room_a + room_b + "</spaces></floor></building>";
 }
 
-void syntheticHiddenRoomA(OccupancyGrid* map, DoorsFile* doors, cv::Mat1w* truth) {
-  const Environment environment = parseEnvironment(corridorWithTwoRoomsXml(), "synthetic");
-  RenderedEnvironment rendered = renderEnvironment(environment, {0});
+void syntheticHiddenRoomA(common::OccupancyGrid* map, common::DoorsFile* doors, cv::Mat1w* truth) {
+  const world::Environment environment = world::parseEnvironment(corridorWithTwoRoomsXml(), "synthetic");
+  world::RenderedEnvironment rendered = world::renderEnvironment(environment, {0});
   const cv::Mat1b room_a = rendered.space_labels == 2;
-  rendered.map.cells.setTo(OccupancyGrid::kUnknown, room_a);
+  rendered.map.cells.setTo(common::OccupancyGrid::kUnknown, room_a);
   *map = rendered.map;
   *doors = rendered.closed_doors;
   *truth = cv::Mat1w::zeros(room_a.size());
@@ -175,20 +175,20 @@ double benchmarkMeanIou(const std::string& method, int* cases) {
   std::getline(csv, line);  // header: env,case,closed_doors_nominal,doors_found,valid,...
   double total = 0.0;
   int scored = 0;
-  const auto predictor = makeRoomPredictor(method);
+  const auto predictor = prediction::makeRoomPredictor(method);
   while (std::getline(csv, line)) {
     std::vector<std::string> fields;
     std::stringstream row(line);
     for (std::string field; std::getline(row, field, ',');) fields.push_back(field);
     if (fields.size() < 5 || fields[4] != "1") continue;
     const std::string dir = root + "/" + fields[0] + "/" + fields[1];
-    PredictionRequest request;
-    request.map = loadMap(dir + "/map.yaml");
-    request.doors = loadDoors(dir + "/doors.yaml");
-    const PredictionResult result = predictor->predict(request);
+    prediction::PredictionRequest request;
+    request.map = common::loadMap(dir + "/map.yaml");
+    request.doors = common::loadDoors(dir + "/doors.yaml");
+    const prediction::PredictionResult result = predictor->predict(request);
     const cv::Mat truth = cv::imread(dir + "/gt_rooms.png", cv::IMREAD_UNCHANGED);
-    total += scoreRooms(roomLabels(request.map, request.doors, result.rooms), truth,
-                        static_cast<int>(request.doors.doors.size()))
+    total += evaluation::scoreRooms(prediction::roomLabels(request.map, request.doors, result.rooms), truth,
+                                    static_cast<int>(request.doors.doors.size()))
                  .mean_iou;
     ++scored;
   }

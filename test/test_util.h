@@ -53,7 +53,7 @@ inline std::vector<std::string> sharedEnvironmentFiles() {
 inline std::string inputErrorMessage(const std::function<void()>& call) {
   try {
     call();
-  } catch (const InputError& error) {
+  } catch (const common::InputError& error) {
     return error.what();
   }
   return "no error";
@@ -102,7 +102,7 @@ std::string corridorWithTwoRoomsXml(const std::string& door1_status = "", const 
 
 // That environment rendered with door 1 closed and room A's free cells unknown: the map a robot exploring the
 // corridor would build, its closed door, and the true room (label 1 on room A).
-void syntheticHiddenRoomA(OccupancyGrid* map, DoorsFile* doors, cv::Mat1w* truth);
+void syntheticHiddenRoomA(common::OccupancyGrid* map, common::DoorsFile* doors, cv::Mat1w* truth);
 
 // Mean IoU of a prediction method over the valid cases of the shared closed-door benchmark, scored as
 // scripts/benchmark_closed_doors.py does (rooms.png labels, mean over each case's doors, then over cases).

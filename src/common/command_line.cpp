@@ -5,7 +5,7 @@
 
 #include "hidden_rooms/common/input_error.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::common {
 
 namespace po = boost::program_options;
 
@@ -38,4 +38,4 @@ bool parseCommandLine(int argc, char** argv, const std::string& usage, const po:
   return true;
 }
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::common

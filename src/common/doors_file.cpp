@@ -8,7 +8,7 @@
 #include "hidden_rooms/common/file_io.h"
 #include "hidden_rooms/common/input_error.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::common {
 
 namespace {
 
@@ -99,4 +99,4 @@ void saveDoors(const DoorsFile& doors, const std::string& path) {
 
 const char* toString(DoorOrientation orientation) { return orientation == DoorOrientation::kAlongX ? "O" : "V"; }
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::common

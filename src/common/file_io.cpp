@@ -10,7 +10,7 @@
 
 #include "hidden_rooms/common/input_error.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::common {
 
 std::string readTextFile(const std::string& path, const std::string& what) {
   std::ifstream file(path, std::ios::binary);
@@ -92,4 +92,4 @@ void createOutputDirectory(const std::string& path) {
     throw InputError(path, "cannot create output folder" + (error ? ": " + error.message() : std::string()));
 }
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::common

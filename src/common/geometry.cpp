@@ -4,7 +4,7 @@
 #include <cmath>
 #include <sstream>
 
-namespace hidden_rooms {
+namespace hidden_rooms::common {
 
 namespace {
 
@@ -100,4 +100,4 @@ Point2 transformPoint(const Pose2& pose, const Point2& point) {
   return {pose.x + c * point.x() - s * point.y(), pose.y + s * point.x() + c * point.y()};
 }
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::common

@@ -15,7 +15,7 @@
 #include "hidden_rooms/common/file_io.h"
 #include "hidden_rooms/common/input_error.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::common {
 
 namespace {
 
@@ -232,4 +232,4 @@ void writeImage(const std::string& path, const cv::Mat& image) {
   writeAtomically(path, [&](const std::string& temporary) { writeImageFile(path, temporary, image); });
 }
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::common

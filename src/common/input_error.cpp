@@ -2,7 +2,7 @@
 
 #include <cstdio>
 
-namespace hidden_rooms {
+namespace hidden_rooms::common {
 
 std::string formatNumber(double value) {
   char buffer[64];
@@ -10,4 +10,4 @@ std::string formatNumber(double value) {
   return buffer;
 }
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::common

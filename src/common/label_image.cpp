@@ -6,7 +6,7 @@
 
 #include "hidden_rooms/common/image_io.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::common {
 
 void saveLabelImage(const cv::Mat1w& labels, const std::string& path) {
   double max_label = 0.0;
@@ -23,4 +23,4 @@ cv::Vec3b roomColour(int label) {
   return bgr(0, 0);
 }
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::common

@@ -11,7 +11,7 @@
 #include "hidden_rooms/common/image_io.h"
 #include "hidden_rooms/common/input_error.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::common {
 
 namespace {
 
@@ -206,4 +206,4 @@ cv::Mat1b reachableFreeCells(const OccupancyGrid& grid, int col, int row) {
   return mask(cv::Rect(1, 1, grid.width(), grid.height())).clone();
 }
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::common

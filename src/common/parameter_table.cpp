@@ -1,6 +1,6 @@
 #include "hidden_rooms/common/parameter_table.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::common {
 
 void requireParameterInRange(const std::string& name, double value, const ParameterRange& range) {
   const bool above_low = range.low_open ? value > range.low : value >= range.low;
@@ -12,4 +12,4 @@ void requireParameterInRange(const std::string& name, double value, const Parame
                                      formatNumber(value));
 }
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::common

@@ -11,7 +11,7 @@
 #include "hidden_rooms/common/input_error.h"
 #include "hidden_rooms/common/range_scan.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::common {
 
 namespace {
 
@@ -117,4 +117,4 @@ double pathLength(const std::vector<TimedPose>& poses) {
   return length;
 }
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::common

@@ -10,7 +10,7 @@
 #include "hidden_rooms/common/input_error.h"
 #include "hidden_rooms/prediction/prediction_support.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::evaluation {
 
 namespace {
 
@@ -21,16 +21,17 @@ double secondsSince(Clock::time_point start) {
 }
 
 // Door indices of the numbers, checked: existing, not repeated.
-std::vector<int> doorIndices(const Environment& environment, const std::vector<int>& numbers) {
+std::vector<int> doorIndices(const world::Environment& environment, const std::vector<int>& numbers) {
   std::vector<int> indices;
   std::set<int> seen;
   for (int number : numbers) {
     const int index = environment.findDoor(std::to_string(number));
     if (index < 0 || environment.doors[index].number != number)
-      throw InputError("closed doors", "door " + std::to_string(number) + " does not exist (the environment has " +
-                                           std::to_string(environment.doors.size()) + " doors)");
+      throw common::InputError("closed doors", "door " + std::to_string(number) +
+                                                   " does not exist (the environment has " +
+                                                   std::to_string(environment.doors.size()) + " doors)");
     if (!seen.insert(number).second)
-      throw InputError("closed doors", "door " + std::to_string(number) + " is closed twice");
+      throw common::InputError("closed doors", "door " + std::to_string(number) + " is closed twice");
     indices.push_back(index);
   }
   return indices;
@@ -43,60 +44,60 @@ double hiddenPercent(const cv::Mat1w& true_rooms, const cv::Mat1b& complete_free
 
 }  // namespace
 
-BatchCase makeBatchCase(const Environment& environment, const std::vector<int>& closed_door_numbers,
-                        const RenderOptions& options) {
+BatchCase makeBatchCase(const world::Environment& environment, const std::vector<int>& closed_door_numbers,
+                        const world::RenderOptions& options) {
   const Clock::time_point start = Clock::now();
   BatchCase result;
   result.closed_door_numbers = closed_door_numbers;
   const std::vector<int> indices = doorIndices(environment, closed_door_numbers);
-  const RenderedEnvironment rendered =
-      renderEnvironment(environment, std::set<int>(indices.begin(), indices.end()), options);
-  const cv::Mat1b complete_free = rendered.map.cells == OccupancyGrid::kFree;
-  result.input = hideClosedRooms(environment, rendered);
+  const world::RenderedEnvironment rendered =
+      world::renderEnvironment(environment, std::set<int>(indices.begin(), indices.end()), options);
+  const cv::Mat1b complete_free = rendered.map.cells == common::OccupancyGrid::kFree;
+  result.input = world::hideClosedRooms(environment, rendered);
   result.hidden_percent = hiddenPercent(result.input.true_rooms, complete_free);
   result.seconds = secondsSince(start);
   return result;
 }
 
-BatchCase makeBatchCaseFromMap(const Environment& environment, const OccupancyGrid& complete_map,
-                               const DoorsFile& doors_in_map, const std::vector<int>& closed_door_numbers,
+BatchCase makeBatchCaseFromMap(const world::Environment& environment, const common::OccupancyGrid& complete_map,
+                               const common::DoorsFile& doors_in_map, const std::vector<int>& closed_door_numbers,
                                double door_width, double wall_margin) {
   const Clock::time_point start = Clock::now();
-  if (complete_map.empty()) throw InputError("map", "the complete map is empty");
+  if (complete_map.empty()) throw common::InputError("map", "the complete map is empty");
   if (!(door_width > 0.0) || !(wall_margin >= 0.0))
-    throw InputError("batch options", "door width must be positive and wall margin not negative");
+    throw common::InputError("batch options", "door width must be positive and wall margin not negative");
   BatchCase result;
   result.closed_door_numbers = closed_door_numbers;
   const std::vector<int> indices = doorIndices(environment, closed_door_numbers);
 
   // Door centres in both frames -> least-squares rigid transform environment -> map (2-D Kabsch).
-  std::map<int, Point2> in_map;
-  for (const MapDoor& door : doors_in_map.doors) in_map[door.id] = door.position;
-  std::vector<std::pair<Point2, Point2>> pairs;
-  for (const Door& door : environment.doors)
+  std::map<int, common::Point2> in_map;
+  for (const common::MapDoor& door : doors_in_map.doors) in_map[door.id] = door.position;
+  std::vector<std::pair<common::Point2, common::Point2>> pairs;
+  for (const world::Door& door : environment.doors)
     if (in_map.count(door.number)) pairs.emplace_back(door.centre, in_map[door.number]);
   for (int number : closed_door_numbers)
     if (!in_map.count(number))
-      throw InputError("doors in map", "closed door " + std::to_string(number) + " has no position in the map");
-  if (pairs.size() < 2) throw InputError("doors in map", "need the positions of at least two doors");
-  Point2 mean_env = Point2::Zero(), mean_map = Point2::Zero();
+      throw common::InputError("doors in map", "closed door " + std::to_string(number) + " has no position in the map");
+  if (pairs.size() < 2) throw common::InputError("doors in map", "need the positions of at least two doors");
+  common::Point2 mean_env = common::Point2::Zero(), mean_map = common::Point2::Zero();
   for (const auto& [e, m] : pairs) mean_env += e, mean_map += m;
   mean_env /= static_cast<double>(pairs.size());
   mean_map /= static_cast<double>(pairs.size());
   double s_cos = 0.0, s_sin = 0.0;
   for (const auto& [e, m] : pairs) {
-    const Point2 a = e - mean_env, b = m - mean_map;
+    const common::Point2 a = e - mean_env, b = m - mean_map;
     s_cos += a.dot(b);
     s_sin += a.x() * b.y() - a.y() * b.x();
   }
   const double angle = std::atan2(s_sin, s_cos);
   Eigen::Matrix2d rotation;
   rotation << std::cos(angle), -std::sin(angle), std::sin(angle), std::cos(angle);
-  const auto toMap = [&](const Point2& p) -> Point2 { return rotation * (p - mean_env) + mean_map; };
-  const auto toCells = [&](const Polygon& polygon) {
+  const auto toMap = [&](const common::Point2& p) -> common::Point2 { return rotation * (p - mean_env) + mean_map; };
+  const auto toCells = [&](const common::Polygon& polygon) {
     std::vector<cv::Point> points;
-    for (const Point2& p : polygon) {
-      const Point2 image = complete_map.toImage(toMap(p));
+    for (const common::Point2& p : polygon) {
+      const common::Point2 image = complete_map.toImage(toMap(p));
       points.emplace_back(static_cast<int>(std::floor(image.x())), static_cast<int>(std::floor(image.y())));
     }
     return points;
@@ -106,8 +107,8 @@ BatchCase makeBatchCaseFromMap(const Environment& environment, const OccupancyGr
   // order, as renderEnvironment writes it).
   std::vector<int> ordered = indices;
   std::sort(ordered.begin(), ordered.end());
-  const cv::Mat1b complete_free = complete_map.cells == OccupancyGrid::kFree;
-  HiddenRoomsCase& hidden = result.input;
+  const cv::Mat1b complete_free = complete_map.cells == common::OccupancyGrid::kFree;
+  world::HiddenRoomsCase& hidden = result.input;
   hidden.map = complete_map;
   hidden.map.cells = complete_map.cells.clone();  // the copy shares the caller's cells
   hidden.closed_doors.frame = doors_in_map.frame.empty() ? "map" : doors_in_map.frame;
@@ -117,11 +118,11 @@ BatchCase makeBatchCaseFromMap(const Environment& environment, const OccupancyGr
   const cv::Mat kernel =
       cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * margin_cells + 1, 2 * margin_cells + 1));
   for (size_t k = 0; k < ordered.size(); ++k) {
-    const Door& door = environment.doors[ordered[k]];
-    const int room = roomBehindDoor(environment, ordered[k]);
+    const world::Door& door = environment.doors[ordered[k]];
+    const int room = world::roomBehindDoor(environment, ordered[k]);
     if (room < 0)
-      throw InputError("closed doors", "door " + std::to_string(door.number) +
-                                           " is not closable: no room lies behind it alone");
+      throw common::InputError(
+          "closed doors", "door " + std::to_string(door.number) + " is not closable: no room lies behind it alone");
     cv::Mat1b outline = cv::Mat1b::zeros(complete_map.cells.size());
     const std::vector<std::vector<cv::Point>> polygons{toCells(environment.spaces[room].outline)};
     cv::fillPoly(outline, polygons, cv::Scalar(255));
@@ -129,13 +130,14 @@ BatchCase makeBatchCaseFromMap(const Environment& environment, const OccupancyGr
     cv::Mat1b grown;
     cv::dilate(outline, grown, kernel);
     erase |= grown;
-    MapDoor closed;
+    common::MapDoor closed;
     closed.id = door.number;
     closed.position = in_map[door.number];
     closed.width = door_width;
     const double wall_angle = door.wall_angle + angle;
-    closed.orientation = std::abs(std::cos(wall_angle)) >= std::abs(std::sin(wall_angle)) ? DoorOrientation::kAlongX
-                                                                                           : DoorOrientation::kAlongY;
+    closed.orientation = std::abs(std::cos(wall_angle)) >= std::abs(std::sin(wall_angle))
+                             ? common::DoorOrientation::kAlongX
+                             : common::DoorOrientation::kAlongY;
     hidden.closed_doors.doors.push_back(closed);
   }
   // Erase the rooms and the walls around them, except the wall cells that explored free space sees (within the
@@ -143,39 +145,40 @@ BatchCase makeBatchCaseFromMap(const Environment& environment, const OccupancyGr
   const cv::Mat1b visible_free = complete_free & ~(hidden.true_rooms > 0);
   cv::Mat1b near_visible;
   cv::dilate(visible_free, near_visible, kernel);
-  hidden.map.cells.setTo(OccupancyGrid::kUnknown, hidden.true_rooms > 0);
-  hidden.map.cells.setTo(OccupancyGrid::kUnknown, erase & ~near_visible & ~complete_free);
+  hidden.map.cells.setTo(common::OccupancyGrid::kUnknown, hidden.true_rooms > 0);
+  hidden.map.cells.setTo(common::OccupancyGrid::kUnknown, erase & ~near_visible & ~complete_free);
   // Paint each closed door as a wall across its width.
   const int thickness = std::max(2, 2 * margin_cells);
-  for (const MapDoor& door : hidden.closed_doors.doors) {
-    const Point2 along = door.orientation == DoorOrientation::kAlongX ? Point2(1, 0) : Point2(0, 1);
-    const Point2 a = complete_map.toImage(door.position - 0.5 * door.width * along);
-    const Point2 b = complete_map.toImage(door.position + 0.5 * door.width * along);
+  for (const common::MapDoor& door : hidden.closed_doors.doors) {
+    const common::Point2 along =
+        door.orientation == common::DoorOrientation::kAlongX ? common::Point2(1, 0) : common::Point2(0, 1);
+    const common::Point2 a = complete_map.toImage(door.position - 0.5 * door.width * along);
+    const common::Point2 b = complete_map.toImage(door.position + 0.5 * door.width * along);
     cv::line(hidden.map.cells, cv::Point(static_cast<int>(a.x()), static_cast<int>(a.y())),
-             cv::Point(static_cast<int>(b.x()), static_cast<int>(b.y())), cv::Scalar(OccupancyGrid::kOccupied),
+             cv::Point(static_cast<int>(b.x()), static_cast<int>(b.y())), cv::Scalar(common::OccupancyGrid::kOccupied),
              thickness, cv::LINE_8);
   }
-  hidden.true_rooms.setTo(0, hidden.map.cells == OccupancyGrid::kOccupied);  // the doors' walls
+  hidden.true_rooms.setTo(0, hidden.map.cells == common::OccupancyGrid::kOccupied);  // the doors' walls
   result.hidden_percent = hiddenPercent(hidden.true_rooms, complete_free);
   result.seconds = secondsSince(start);
   return result;
 }
 
-MethodOutcome runMethodOnCase(const RoomPredictor& method, const BatchCase& batch_case,
+MethodOutcome runMethodOnCase(const prediction::RoomPredictor& method, const BatchCase& batch_case,
                               const std::map<std::string, double>& parameters) {
   const Clock::time_point start = Clock::now();
   MethodOutcome outcome;
   outcome.method = method.name();
   const int doors = static_cast<int>(batch_case.input.closed_doors.doors.size());
   try {
-    PredictionRequest request;
+    prediction::PredictionRequest request;
     request.map = batch_case.input.map;
     request.doors = batch_case.input.closed_doors;
     request.parameters = parameters;
-    const PredictionResult result = method.predict(request);
-    for (const RoomPrediction& room : result.rooms) outcome.not_placed += room.placed ? 0 : 1;
-    outcome.scores =
-        scoreRooms(roomLabels(request.map, request.doors, result.rooms), batch_case.input.true_rooms, doors);
+    const prediction::PredictionResult result = method.predict(request);
+    for (const prediction::RoomPrediction& room : result.rooms) outcome.not_placed += room.placed ? 0 : 1;
+    outcome.scores = scoreRooms(prediction::roomLabels(request.map, request.doors, result.rooms),
+                                batch_case.input.true_rooms, doors);
   } catch (const std::exception& error) {
     outcome.problem = error.what();
     outcome.scores = RoomScores();
@@ -185,4 +188,4 @@ MethodOutcome runMethodOnCase(const RoomPredictor& method, const BatchCase& batc
   return outcome;
 }
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::evaluation

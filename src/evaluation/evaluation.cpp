@@ -2,13 +2,13 @@
 
 #include "hidden_rooms/common/input_error.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::evaluation {
 
 namespace {
 
 cv::Mat1i asLabels(const cv::Mat& image, const char* what) {
   if (image.channels() != 1 || (image.depth() != CV_8U && image.depth() != CV_16U && image.depth() != CV_32S))
-    throw InputError(what, "label image must be single-channel 8-, 16- or 32-bit integers");
+    throw common::InputError(what, "label image must be single-channel 8-, 16- or 32-bit integers");
   cv::Mat1i labels;
   image.convertTo(labels, CV_32S);
   return labels;
@@ -18,7 +18,7 @@ cv::Mat1i asLabels(const cv::Mat& image, const char* what) {
 
 RoomScores scoreRooms(const cv::Mat& predicted_labels, const cv::Mat& true_labels, int door_count) {
   if (predicted_labels.size() != true_labels.size())
-    throw InputError("labels", "predicted and true label images differ in size");
+    throw common::InputError("labels", "predicted and true label images differ in size");
   const cv::Mat1i predicted = asLabels(predicted_labels, "predicted labels");
   const cv::Mat1i truth = asLabels(true_labels, "true labels");
   std::vector<long long> intersection(door_count + 1, 0), predicted_count(door_count + 1, 0),
@@ -44,4 +44,4 @@ RoomScores scoreRooms(const cv::Mat& predicted_labels, const cv::Mat& true_label
   return scores;
 }
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::evaluation

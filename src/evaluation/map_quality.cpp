@@ -5,7 +5,7 @@
 
 #include <opencv2/imgproc.hpp>
 
-namespace hidden_rooms {
+namespace hidden_rooms::evaluation {
 
 namespace {
 
@@ -17,7 +17,8 @@ bool isOccupied(int8_t value) { return value >= kOccupiedMin; }
 
 }  // namespace
 
-void markObservedCells(const OccupancyGrid& truth, const Pose2& laser_pose, const RangeScan& scan, cv::Mat1b* observed) {
+void markObservedCells(const common::OccupancyGrid& truth, const common::Pose2& laser_pose,
+                       const common::RangeScan& scan, cv::Mat1b* observed) {
   if (observed->empty() || observed->rows != truth.height() || observed->cols != truth.width())
     *observed = cv::Mat1b::zeros(truth.height(), truth.width());
   const double step = 0.5 * truth.resolution;
@@ -29,25 +30,26 @@ void markObservedCells(const OccupancyGrid& truth, const Pose2& laser_pose, cons
     const double dx = std::cos(angle), dy = std::sin(angle);
     for (double t = 0.0; t < length; t += step) {
       int col = 0, row = 0;
-      if (!truth.cellOf(Point2(laser_pose.x + t * dx, laser_pose.y + t * dy), &col, &row)) break;
+      if (!truth.cellOf(common::Point2(laser_pose.x + t * dx, laser_pose.y + t * dy), &col, &row)) break;
       (*observed)(row, col) = 255;
     }
   }
 }
 
-MapQuality evaluateMap(const OccupancyGrid& map, const Pose2& world_from_map, const OccupancyGrid& truth,
-                       const cv::Mat1b& observed) {
+MapQuality evaluateMap(const common::OccupancyGrid& map, const common::Pose2& world_from_map,
+                       const common::OccupancyGrid& truth, const cv::Mat1b& observed) {
   MapQuality quality;
   const bool restrict = !observed.empty();
-  const Pose2 map_from_world = invertPose(world_from_map);
+  const common::Pose2 map_from_world = common::invertPose(world_from_map);
   long long union_cells = 0;
   for (int row = 0; row < truth.height(); ++row) {
     for (int col = 0; col < truth.width(); ++col) {
       const bool truly_free = isFree(truth.cells(row, col)) && (!restrict || observed(row, col) != 0);
       int map_col = 0, map_row = 0;
-      const bool mapped_free = !map.empty() &&
-                               map.cellOf(transformPoint(map_from_world, truth.cellCentre(col, row)), &map_col, &map_row) &&
-                               isFree(map.cells(map_row, map_col));
+      const bool mapped_free =
+          !map.empty() &&
+          map.cellOf(common::transformPoint(map_from_world, truth.cellCentre(col, row)), &map_col, &map_row) &&
+          isFree(map.cells(map_row, map_col));
       quality.true_free_cells += truly_free;
       quality.map_free_cells += mapped_free;
       quality.intersection_cells += truly_free && mapped_free;
@@ -68,7 +70,8 @@ MapQuality evaluateMap(const OccupancyGrid& map, const Pose2& world_from_map, co
       const int8_t value = map.cells(row, col);
       if (!isFree(value) && !isOccupied(value)) continue;
       int truth_col = 0, truth_row = 0;
-      const bool inside = truth.cellOf(transformPoint(world_from_map, map.cellCentre(col, row)), &truth_col, &truth_row);
+      const bool inside =
+          truth.cellOf(common::transformPoint(world_from_map, map.cellCentre(col, row)), &truth_col, &truth_row);
       if (isFree(value) && !inside) {  // free space mapped outside the world's grid: wrong by definition
         ++quality.map_free_cells;
         ++union_cells;
@@ -96,19 +99,20 @@ MapQuality evaluateMap(const OccupancyGrid& map, const Pose2& world_from_map, co
   return quality;
 }
 
-cv::Mat3b drawMapComparison(const OccupancyGrid& map, const Pose2& world_from_map, const OccupancyGrid& truth,
-                            const cv::Mat1b& observed) {
-  const Pose2 map_from_world = invertPose(world_from_map);
+cv::Mat3b drawMapComparison(const common::OccupancyGrid& map, const common::Pose2& world_from_map,
+                            const common::OccupancyGrid& truth, const cv::Mat1b& observed) {
+  const common::Pose2 map_from_world = common::invertPose(world_from_map);
   cv::Mat3b picture(truth.height(), truth.width(), cv::Vec3b(160, 160, 160));
   for (int row = 0; row < truth.height(); ++row) {
     for (int col = 0; col < truth.width(); ++col) {
       const int8_t true_value = truth.cells(row, col);
       const bool truly_free = isFree(true_value) && (observed.empty() || observed(row, col) != 0);
       int map_col = 0, map_row = 0;
-      const int8_t mapped = !map.empty() && map.cellOf(transformPoint(map_from_world, truth.cellCentre(col, row)),
-                                                       &map_col, &map_row)
-                                ? map.cells(map_row, map_col)
-                                : OccupancyGrid::kUnknown;
+      const int8_t mapped =
+          !map.empty() &&
+                  map.cellOf(common::transformPoint(map_from_world, truth.cellCentre(col, row)), &map_col, &map_row)
+              ? map.cells(map_row, map_col)
+              : common::OccupancyGrid::kUnknown;
       cv::Vec3b& pixel = picture(row, col);
       if (truly_free && isFree(mapped)) pixel = {255, 255, 255};
       else if (truly_free && isOccupied(mapped)) pixel = {255, 0, 255};
@@ -120,13 +124,13 @@ cv::Mat3b drawMapComparison(const OccupancyGrid& map, const Pose2& world_from_ma
   return picture;
 }
 
-TrajectoryError trajectoryError(const std::vector<Pose2>& estimate, const std::vector<Pose2>& truth,
-                                const Pose2& world_from_map) {
+TrajectoryError trajectoryError(const std::vector<common::Pose2>& estimate, const std::vector<common::Pose2>& truth,
+                                const common::Pose2& world_from_map) {
   TrajectoryError error;
   const size_t n = std::min(estimate.size(), truth.size());
   double position_sum = 0.0, yaw_sum = 0.0;
   for (size_t i = 0; i < n; ++i) {
-    const Pose2 placed = composePoses(world_from_map, estimate[i]);
+    const common::Pose2 placed = common::composePoses(world_from_map, estimate[i]);
     const double d = std::hypot(placed.x - truth[i].x, placed.y - truth[i].y);
     const double yaw = std::atan2(std::sin(placed.yaw - truth[i].yaw), std::cos(placed.yaw - truth[i].yaw));
     position_sum += d * d;
@@ -141,4 +145,4 @@ TrajectoryError trajectoryError(const std::vector<Pose2>& estimate, const std::v
   return error;
 }
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::evaluation

@@ -12,22 +12,22 @@
 #include "hidden_rooms/common/label_image.h"
 #include "hidden_rooms/prediction/prediction_support.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::evaluation {
 namespace {
 
 void writeYaml(const YAML::Emitter& out, const std::string& path) {
-  writeTextAtomically(path, std::string(out.c_str()) + "\n", "YAML file");
+  common::writeTextAtomically(path, std::string(out.c_str()) + "\n", "YAML file");
 }
 
-void writeRoomsYaml(const PredictionRequest& request, const PredictionResult& result, const std::string& method,
-                    const std::string& path) {
+void writeRoomsYaml(const prediction::PredictionRequest& request, const prediction::PredictionResult& result,
+                    const std::string& method, const std::string& path) {
   YAML::Emitter out;
   out << YAML::BeginMap << YAML::Key << "method" << YAML::Value << method;
   out << YAML::Key << "frame" << YAML::Value << request.doors.frame;
   out << YAML::Key << "seconds" << YAML::Value << result.seconds;
   out << YAML::Key << "rooms" << YAML::Value << YAML::BeginSeq;
   for (size_t k = 0; k < result.rooms.size(); ++k) {
-    const RoomPrediction& room = result.rooms[k];
+    const prediction::RoomPrediction& room = result.rooms[k];
     out << YAML::BeginMap;
     out << YAML::Key << "door_id" << YAML::Value << room.door_id;
     out << YAML::Key << "label" << YAML::Value << k + 1;
@@ -35,7 +35,7 @@ void writeRoomsYaml(const PredictionRequest& request, const PredictionResult& re
     if (!room.placed) out << YAML::Key << "problem" << YAML::Value << room.problem;
     out << YAML::Key << "area" << YAML::Value << room.area;
     out << YAML::Key << "polygon" << YAML::Value << YAML::BeginSeq;
-    for (const Point2& p : room.polygon) out << YAML::Flow << YAML::BeginSeq << p.x() << p.y() << YAML::EndSeq;
+    for (const common::Point2& p : room.polygon) out << YAML::Flow << YAML::BeginSeq << p.x() << p.y() << YAML::EndSeq;
     out << YAML::EndSeq;
     out << YAML::Key << "terms" << YAML::Value << YAML::BeginMap;
     for (const auto& [name, value] : room.terms) out << YAML::Key << name << YAML::Value << value;
@@ -45,7 +45,7 @@ void writeRoomsYaml(const PredictionRequest& request, const PredictionResult& re
   writeYaml(out, path);
 }
 
-void writeMetrics(const PredictionRequest& request, const RoomScores& scores, const std::string& path) {
+void writeMetrics(const prediction::PredictionRequest& request, const RoomScores& scores, const std::string& path) {
   YAML::Emitter out;
   out << YAML::BeginMap << YAML::Key << "mean_iou" << YAML::Value << scores.mean_iou;
   out << YAML::Key << "iou_total" << YAML::Value << scores.iou_total;
@@ -59,17 +59,18 @@ void writeMetrics(const PredictionRequest& request, const RoomScores& scores, co
 
 }  // namespace
 
-PredictionOutputs writePredictionOutputs(const PredictionRequest& request, const PredictionResult& result,
-                                         const std::string& method, const std::string& out_dir,
-                                         const cv::Mat& true_labels) {
-  createOutputDirectory(out_dir);
+PredictionOutputs writePredictionOutputs(const prediction::PredictionRequest& request,
+                                         const prediction::PredictionResult& result, const std::string& method,
+                                         const std::string& out_dir, const cv::Mat& true_labels) {
+  common::createOutputDirectory(out_dir);
   const std::filesystem::path out(out_dir);
   PredictionOutputs outputs;
-  outputs.labels = roomLabels(request.map, request.doors, result.rooms);
-  saveLabelImage(outputs.labels, (out / "rooms.png").string());
+  outputs.labels = prediction::roomLabels(request.map, request.doors, result.rooms);
+  common::saveLabelImage(outputs.labels, (out / "rooms.png").string());
   writeRoomsYaml(request, result, method, (out / "rooms.yaml").string());
-  saveMap(insertRooms(request.map, request.doors, result.rooms), (out / "map").string());
-  writeImage((out / "overlay.png").string(), renderPredictionOverlay(request.map, outputs.labels, true_labels));
+  common::saveMap(prediction::insertRooms(request.map, request.doors, result.rooms), (out / "map").string());
+  common::writeImage((out / "overlay.png").string(),
+                     prediction::renderPredictionOverlay(request.map, outputs.labels, true_labels));
   if (!true_labels.empty()) {
     outputs.scores = scoreRooms(outputs.labels, true_labels, static_cast<int>(request.doors.doors.size()));
     writeMetrics(request, *outputs.scores, (out / "metrics.yaml").string());
@@ -77,25 +78,26 @@ PredictionOutputs writePredictionOutputs(const PredictionRequest& request, const
   return outputs;
 }
 
-cv::Mat loadTrueRooms(const std::string& path, const OccupancyGrid& map) {
+cv::Mat loadTrueRooms(const std::string& path, const common::OccupancyGrid& map) {
   cv::Mat truth;
   try {
-    truth = readImage(path);
-  } catch (const InputError& error) {
-    throw InputError(path, "cannot read the true rooms image: " + error.problem());
+    truth = common::readImage(path);
+  } catch (const common::InputError& error) {
+    throw common::InputError(path, "cannot read the true rooms image: " + error.problem());
   }
   if (truth.size() != map.cells.size())
-    throw InputError(path, "true rooms image is " + std::to_string(truth.cols) + "x" + std::to_string(truth.rows) +
-                               ", the map " + std::to_string(map.width()) + "x" + std::to_string(map.height()));
+    throw common::InputError(path, "true rooms image is " + std::to_string(truth.cols) + "x" +
+                                       std::to_string(truth.rows) + ", the map " + std::to_string(map.width()) + "x" +
+                                       std::to_string(map.height()));
   return truth;
 }
 
-void printPredictionSummary(std::ostream& out, const PredictionRequest& request, const PredictionResult& result,
-                            const std::string& method, const std::string& out_dir,
-                            const PredictionOutputs& outputs) {
+void printPredictionSummary(std::ostream& out, const prediction::PredictionRequest& request,
+                            const prediction::PredictionResult& result, const std::string& method,
+                            const std::string& out_dir, const PredictionOutputs& outputs) {
   out << method << ": " << result.rooms.size() << " doors in " << std::fixed << std::setprecision(3)
       << result.seconds << " s -> " << out_dir << std::endl;
-  for (const RoomPrediction& room : result.rooms)
+  for (const prediction::RoomPrediction& room : result.rooms)
     if (!room.placed) out << "  door " << room.door_id << " not placed: " << room.problem << std::endl;
   if (outputs.scores) {
     const RoomScores& scores = *outputs.scores;
@@ -105,4 +107,4 @@ void printPredictionSummary(std::ostream& out, const PredictionRequest& request,
   }
 }
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::evaluation

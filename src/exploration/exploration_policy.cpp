@@ -1,13 +1,14 @@
 #include "hidden_rooms/exploration/exploration_policy.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::exploration {
 
 namespace {
 
 // Half ROS time's resolution: time differences closer than this to a threshold reach it.
 constexpr double kTimeEpsilon = 0.5e-9;
 
-ExplorationEvent event(ExplorationEventType type, const Point2& position = Point2::Zero(), size_t count = 0) {
+ExplorationEvent event(ExplorationEventType type, const common::Point2& position = common::Point2::Zero(),
+                       size_t count = 0) {
   ExplorationEvent result;
   result.type = type;
   result.position = position;
@@ -26,27 +27,27 @@ ExplorationPolicy::ExplorationPolicy(const ExplorationPolicyOptions& options)
   blacklist_.radius = options.blacklist_radius;
 }
 
-void ExplorationPolicy::setMap(const OccupancyGrid& map) {
+void ExplorationPolicy::setMap(const common::OccupancyGrid& map) {
   next_map_ = map;
   pending_map_ = PendingMap::kUsable;
 }
 
 void ExplorationPolicy::setUnusableMap(const std::string& reason) {
-  next_map_ = OccupancyGrid();
+  next_map_ = common::OccupancyGrid();
   unusable_reason_ = reason;
   pending_map_ = PendingMap::kUnusable;
 }
 
-void ExplorationPolicy::addScan(const std::vector<Point2>& points, const Pose2& pose, double time) {
+void ExplorationPolicy::addScan(const std::vector<common::Point2>& points, const common::Pose2& pose, double time) {
   obstacle_memory_.add(points, pose, time);
 }
 
 void ExplorationPolicy::hold(double time) { follower_.hold(time); }
 
-ExplorationStep ExplorationPolicy::update(const Pose2& pose, double time) {
+ExplorationStep ExplorationPolicy::update(const common::Pose2& pose, double time) {
   ExplorationStep step;
   // The follower sees the latest scan and the remembered ones (placed with the robot's current pose).
-  const std::vector<Point2> obstacles = obstacle_memory_.points(pose);
+  const std::vector<common::Point2> obstacles = obstacle_memory_.points(pose);
 
   // Replan on a new map, every replan_interval, and when the follower has nothing to do; recovery manoeuvres
   // run to their end first.
@@ -74,7 +75,7 @@ ExplorationStep ExplorationPolicy::update(const Pose2& pose, double time) {
   return step;
 }
 
-void ExplorationPolicy::finishGoal(const Pose2& pose, FollowerState outcome, ExplorationStep* step) {
+void ExplorationPolicy::finishGoal(const common::Pose2& pose, FollowerState outcome, ExplorationStep* step) {
   // A reached goal whose frontier is still there next time cannot be seen from there: no goal near it again.
   // A failed one gets one more try when nothing else is left; one failed because the robot could not move at
   // all (no recovery moved it), a try each time nothing else is left.
@@ -93,7 +94,7 @@ void ExplorationPolicy::finishGoal(const Pose2& pose, FollowerState outcome, Exp
   step->events.push_back(ended);
 
   const size_t blocked_before = passages_.blockedPoints().size();
-  const Point2 robot(pose.x, pose.y);
+  const common::Point2 robot(pose.x, pose.y);
   if (failed && !robot_stuck && passages_.addFailure(robot, follower_.path())) {
     planner_.setBlockedPoints(passages_.blockedPoints(), options_.passages.radius);
     step->events.push_back(event(passages_.blockedPoints().size() > blocked_before
@@ -104,7 +105,7 @@ void ExplorationPolicy::finishGoal(const Pose2& pose, FollowerState outcome, Exp
   goal_.reset();
 }
 
-void ExplorationPolicy::plan(const Pose2& pose, double time, ExplorationStep* step) {
+void ExplorationPolicy::plan(const common::Pose2& pose, double time, ExplorationStep* step) {
   last_plan_ = time;
   const PendingMap pending = pending_map_;
   pending_map_ = PendingMap::kNone;
@@ -117,17 +118,18 @@ void ExplorationPolicy::plan(const Pose2& pose, double time, ExplorationStep* st
   const bool new_map = pending == PendingMap::kUsable;
   if (new_map) {
     planner_.setMap(next_map_);
-    next_map_ = OccupancyGrid();
+    next_map_ = common::OccupancyGrid();
   }
-  const Point2 robot(pose.x, pose.y);
+  const common::Point2 robot(pose.x, pose.y);
   frontiers_ = findFrontiers(planner_.map(), options_.frontiers);
   step->planned = true;
   if (!planner_.computeCostsFrom(robot)) {
     step->events.push_back(event(ExplorationEventType::kStartBlocked, robot));
     return;
   }
-  const std::optional<Point2> previous =
-      goal_ && follower_.state() == FollowerState::kFollowing ? std::optional<Point2>(goal_->position) : std::nullopt;
+  const std::optional<common::Point2> previous = goal_ && follower_.state() == FollowerState::kFollowing
+                                                     ? std::optional<common::Point2>(goal_->position)
+                                                     : std::nullopt;
   // The nearest goal with the current blacklist and costs (tried again after each release below).
   const auto nearest = [&] {
     return nearestFrontierGoal(frontiers_, planner_, blacklist_, options_.frontiers, previous,
@@ -176,7 +178,7 @@ void ExplorationPolicy::plan(const Pose2& pose, double time, ExplorationStep* st
     done_ = false;
     step->events.push_back(event(ExplorationEventType::kResumed, robot));
   }
-  const std::vector<Point2> path = planner_.pathTo(goal->cell.x, goal->cell.y);
+  const std::vector<common::Point2> path = planner_.pathTo(goal->cell.x, goal->cell.y);
   const bool same_goal = goal_ && (goal_->position - goal->position).norm() < 1e-6;
   if (same_goal && follower_.state() == FollowerState::kFollowing) {
     follower_.updatePath(path);
@@ -190,4 +192,4 @@ void ExplorationPolicy::plan(const Pose2& pose, double time, ExplorationStep* st
   goal_ = goal;
 }
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::exploration

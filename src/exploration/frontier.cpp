@@ -8,9 +8,9 @@
 
 #include "hidden_rooms/common/input_error.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::exploration {
 
-FrontierMap findFrontiers(const OccupancyGrid& map, const FrontierOptions& options) {
+FrontierMap findFrontiers(const common::OccupancyGrid& map, const FrontierOptions& options) {
   FrontierMap result;
   if (map.empty()) return result;
   const int rows = map.height(), cols = map.width();
@@ -64,18 +64,18 @@ FrontierMap findFrontiers(const OccupancyGrid& map, const FrontierOptions& optio
   return result;
 }
 
-bool Blacklist::contains(const Point2& point) const {
+bool Blacklist::contains(const common::Point2& point) const {
   return std::any_of(points.begin(), points.end(),
-                     [&](const Point2& listed) { return (listed - point).norm() <= radius; });
+                     [&](const common::Point2& listed) { return (listed - point).norm() <= radius; });
 }
 
-bool Blacklist::add(const Point2& point, GoalOutcome outcome) {
+bool Blacklist::add(const common::Point2& point, GoalOutcome outcome) {
   points.push_back(point);
   if (outcome == GoalOutcome::kRobotStuck) {
     stuck_points.push_back(point);
     return true;
   }
-  const auto near = [&](const Point2& place) { return (place - point).norm() <= radius; };
+  const auto near = [&](const common::Point2& place) { return (place - point).norm() <= radius; };
   if (outcome != GoalOutcome::kFailed || std::any_of(retried_points.begin(), retried_points.end(), near)) return false;
   failed_points.push_back(point);
   return true;
@@ -84,8 +84,8 @@ bool Blacklist::add(const Point2& point, GoalOutcome outcome) {
 namespace {
 
 // Removes every occurrence of each of `released` from `points`; returns how many `released` there were.
-size_t removePoints(std::vector<Point2>* released, std::vector<Point2>* points) {
-  for (const Point2& place : *released)
+size_t removePoints(std::vector<common::Point2>* released, std::vector<common::Point2>* points) {
+  for (const common::Point2& place : *released)
     points->erase(std::remove(points->begin(), points->end(), place), points->end());
   const size_t count = released->size();
   released->clear();
@@ -103,7 +103,7 @@ size_t Blacklist::releaseFailed() {
 
 void validate(const BlockedPassagesOptions& options) {
   const auto require = [](bool ok, const std::string& what) {
-    if (!ok) throw InputError("explorer options", what);
+    if (!ok) throw common::InputError("explorer options", what);
   };
   require(options.failures >= 0, "blocked_passage_failures must be >= 0");
   for (const double value : {options.same_place, options.same_direction, options.skip, options.length, options.radius})
@@ -113,15 +113,15 @@ void validate(const BlockedPassagesOptions& options) {
 
 BlockedPassages::BlockedPassages(const BlockedPassagesOptions& options) : options_(options) { validate(options_); }
 
-bool BlockedPassages::addFailure(const Point2& robot, const std::vector<Point2>& path) {
+bool BlockedPassages::addFailure(const common::Point2& robot, const std::vector<common::Point2>& path) {
   if (options_.failures <= 0 || path.empty()) return false;
-  const auto here = [&](const Point2& place) { return (place - robot).norm() <= options_.same_place; };
+  const auto here = [&](const common::Point2& place) { return (place - robot).norm() <= options_.same_place; };
   if (std::any_of(wedged_.begin(), wedged_.end(), here)) return false;
   // The stretch: path points between skip and length metres along the path from the point nearest the robot.
   size_t nearest = 0;
   for (size_t i = 1; i < path.size(); ++i)
     if ((path[i] - robot).norm() < (path[nearest] - robot).norm()) nearest = i;
-  Failure failure{robot, Point2::Zero(), {}, false};
+  Failure failure{robot, common::Point2::Zero(), {}, false};
   double along = 0.0;
   for (size_t i = nearest + 1; i < path.size() && along <= options_.length; ++i) {
     along += (path[i] - path[i - 1]).norm();
@@ -166,14 +166,14 @@ size_t BlockedPassages::releaseOnce() {
 
 std::optional<FrontierGoal> nearestFrontierGoal(const FrontierMap& frontiers, const GridPlanner& planner,
                                                 const Blacklist& blacklist, const FrontierOptions& options,
-                                                const std::optional<Point2>& previous, double hysteresis) {
-  const OccupancyGrid& map = planner.map();
+                                                const std::optional<common::Point2>& previous, double hysteresis) {
+  const common::OccupancyGrid& map = planner.map();
   if (map.empty() || frontiers.frontiers.empty() || planner.startCell().x < 0) return std::nullopt;
   const int reach = static_cast<int>(std::floor(options.goal_reach / map.resolution));
   const cv::Mat1b& roomy = planner.roomy();  // goals keep robot_radius from obstacles
 
-  const Point2 robot = map.cellCentre(planner.startCell().x, planner.startCell().y);
-  const auto acceptable = [&](const Point2& position) {
+  const common::Point2 robot = map.cellCentre(planner.startCell().x, planner.startCell().y);
+  const auto acceptable = [&](const common::Point2& position) {
     return (position - robot).norm() >= options.min_goal_distance && !blacklist.contains(position);
   };
   // Per cell, the frontier that claims it (the first one found within reach); cells are visited once.
@@ -188,7 +188,7 @@ std::optional<FrontierGoal> nearestFrontierGoal(const FrontierMap& frontiers, co
           claimed(row, col) = frontier.label;
           const double cost = planner.costTo(col, row);
           if (!std::isfinite(cost) || (best && cost >= best->cost)) continue;
-          const Point2 position = map.cellCentre(col, row);
+          const common::Point2 position = map.cellCentre(col, row);
           if (!acceptable(position)) continue;
           best = FrontierGoal{frontier.label, {col, row}, position, cost};
         }
@@ -204,4 +204,4 @@ std::optional<FrontierGoal> nearestFrontierGoal(const FrontierMap& frontiers, co
   return FrontierGoal{claimed(row, col), {col, row}, map.cellCentre(col, row), cost};
 }
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::exploration

@@ -11,7 +11,7 @@
 
 #include "hidden_rooms/common/input_error.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::exploration {
 
 namespace {
 
@@ -21,7 +21,7 @@ constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
 void validate(const GridPlannerOptions& options) {
   const auto require = [](bool ok, const std::string& what) {
-    if (!ok) throw InputError("explorer options", what);
+    if (!ok) throw common::InputError("explorer options", what);
   };
   require(options.free_threshold >= 0 && options.free_threshold < options.occupied_threshold &&
               options.occupied_threshold <= 100,
@@ -43,7 +43,7 @@ void validate(const GridPlannerOptions& options) {
 
 GridPlanner::GridPlanner(const GridPlannerOptions& options) : options_(options) { validate(options_); }
 
-void GridPlanner::setMap(const OccupancyGrid& map) {
+void GridPlanner::setMap(const common::OccupancyGrid& map) {
   map_ = map;
   start_cell_ = {-1, -1};
   const int rows = map.height(), cols = map.width();
@@ -81,7 +81,7 @@ void GridPlanner::setMap(const OccupancyGrid& map) {
       step_factor_(row, col) = static_cast<float>(narrow * (1.0 + options_.cost_weight * closeness));
     }
   const int blocked_cells = static_cast<int>(std::lround(blocked_radius_ / map.resolution));
-  for (const Point2& point : blocked_points_) {
+  for (const common::Point2& point : blocked_points_) {
     int col = 0, row = 0;
     if (!map.cellOf(point, &col, &row)) continue;
     cv::circle(traversable_, {col, row}, blocked_cells, 0, cv::FILLED);
@@ -89,14 +89,14 @@ void GridPlanner::setMap(const OccupancyGrid& map) {
   }
 }
 
-void GridPlanner::setBlockedPoints(const std::vector<Point2>& points, double radius) {
+void GridPlanner::setBlockedPoints(const std::vector<common::Point2>& points, double radius) {
   blocked_points_ = points;
   blocked_radius_ = radius;
-  const OccupancyGrid map = map_;
+  const common::OccupancyGrid map = map_;
   setMap(map);
 }
 
-bool GridPlanner::computeCostsFrom(const Point2& start) {
+bool GridPlanner::computeCostsFrom(const common::Point2& start) {
   cost_.setTo(kInfinity);
   parent_.setTo(-1);
   start_cell_ = {-1, -1};
@@ -160,13 +160,13 @@ double GridPlanner::costTo(int col, int row) const {
   return cost_(row, col);
 }
 
-double GridPlanner::costTo(const Point2& point) const {
+double GridPlanner::costTo(const common::Point2& point) const {
   int col = 0, row = 0;
   if (map_.empty() || !map_.cellOf(point, &col, &row)) return kInfinity;
   return costTo(col, row);
 }
 
-std::vector<Point2> GridPlanner::pathTo(int col, int row) const {
+std::vector<common::Point2> GridPlanner::pathTo(int col, int row) const {
   if (!std::isfinite(costTo(col, row))) return {};
   std::vector<cv::Point> cells;
   const int cols = map_.width();
@@ -174,18 +174,18 @@ std::vector<Point2> GridPlanner::pathTo(int col, int row) const {
     cells.emplace_back(index % cols, index / cols);
   std::reverse(cells.begin(), cells.end());
 
-  std::vector<Point2> path;
+  std::vector<common::Point2> path;
   path.reserve(cells.size());
   for (const cv::Point& cell : cells) path.push_back(map_.cellCentre(cell.x, cell.y));
   const int half_window = static_cast<int>(std::lround(options_.smoothing_window / map_.resolution));
   if (half_window <= 0 || path.size() < 3) return path;
-  std::vector<Point2> smoothed = path;
+  std::vector<common::Point2> smoothed = path;
   const int n = static_cast<int>(path.size());
   for (int i = 1; i + 1 < n; ++i) {
     const int window = std::min({half_window, i, n - 1 - i});  // symmetric, so the ends stay put
-    Point2 sum = Point2::Zero();
+    common::Point2 sum = common::Point2::Zero();
     for (int j = i - window; j <= i + window; ++j) sum += path[j];
-    const Point2 average = sum / (2 * window + 1);
+    const common::Point2 average = sum / (2 * window + 1);
     int average_col = 0, average_row = 0;
     if (map_.cellOf(average, &average_col, &average_row) && traversable_(average_row, average_col) != 0)
       smoothed[i] = average;
@@ -193,10 +193,10 @@ std::vector<Point2> GridPlanner::pathTo(int col, int row) const {
   return smoothed;
 }
 
-double pathLength(const std::vector<Point2>& path) {
+double pathLength(const std::vector<common::Point2>& path) {
   double length = 0.0;
   for (size_t i = 1; i < path.size(); ++i) length += (path[i] - path[i - 1]).norm();
   return length;
 }
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::exploration

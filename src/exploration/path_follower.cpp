@@ -6,23 +6,27 @@
 
 #include "hidden_rooms/common/input_error.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::exploration {
 
 namespace {
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
 // `point` (map frame) in the frame of a robot at `pose`.
-Point2 toRobotFrame(const Pose2& pose, const Point2& point) { return transformPoint(invertPose(pose), point); }
+common::Point2 toRobotFrame(const common::Pose2& pose, const common::Point2& point) {
+  return common::transformPoint(common::invertPose(pose), point);
+}
 
 }  // namespace
 
 void validate(const PathFollowerOptions& options) {
   const auto positive = [](double value, const char* name) {
-    if (!std::isfinite(value) || value <= 0.0) throw InputError("explorer options", std::string(name) + " must be positive");
+    if (!std::isfinite(value) || value <= 0.0)
+      throw common::InputError("explorer options", std::string(name) + " must be positive");
   };
   const auto non_negative = [](double value, const char* name) {
-    if (!std::isfinite(value) || value < 0.0) throw InputError("explorer options", std::string(name) + " must be >= 0");
+    if (!std::isfinite(value) || value < 0.0)
+      throw common::InputError("explorer options", std::string(name) + " must be >= 0");
   };
   positive(options.max_linear_velocity, "max_linear_velocity");
   positive(options.max_angular_velocity, "max_angular_velocity");
@@ -47,7 +51,7 @@ void validate(const PathFollowerOptions& options) {
   non_negative(options.recovery_rotate_time, "recovery_rotate_time");
   positive(options.progress_timeout, "progress_timeout");
   non_negative(options.progress_distance, "progress_distance");
-  if (options.max_recoveries < 0) throw InputError("explorer options", "max_recoveries must be >= 0");
+  if (options.max_recoveries < 0) throw common::InputError("explorer options", "max_recoveries must be >= 0");
 }
 
 const char* toString(FollowerState state) {
@@ -62,8 +66,8 @@ const char* toString(FollowerState state) {
   return "unknown";
 }
 
-std::vector<Point2> obstaclePoints(const RangeScan& scan, int* skipped) {
-  std::vector<Point2> points;
+std::vector<common::Point2> obstaclePoints(const common::RangeScan& scan, int* skipped) {
+  std::vector<common::Point2> points;
   points.reserve(scan.ranges.size());
   int invalid = 0;
   const double c = std::cos(scan.sensor_pose.yaw), s = std::sin(scan.sensor_pose.yaw);
@@ -81,7 +85,7 @@ std::vector<Point2> obstaclePoints(const RangeScan& scan, int* skipped) {
   return points;
 }
 
-void ObstacleMemory::add(const std::vector<Point2>& points, const Pose2& pose, double time) {
+void ObstacleMemory::add(const std::vector<common::Point2>& points, const common::Pose2& pose, double time) {
   scans_.erase(std::remove_if(scans_.begin(), scans_.end(),
                               [&](const Scan& scan) { return scan.time < time - duration_ || scan.time > time; }),
                scans_.end());
@@ -89,15 +93,15 @@ void ObstacleMemory::add(const std::vector<Point2>& points, const Pose2& pose, d
   scan.time = time;
   scan.points.reserve(points.size());
   const double c = std::cos(pose.yaw), s = std::sin(pose.yaw);
-  for (const Point2& point : points)
+  for (const common::Point2& point : points)
     if (point.allFinite()) scan.points.emplace_back(pose.x + c * point.x() - s * point.y(), pose.y + s * point.x() + c * point.y());
   scans_.push_back(std::move(scan));
 }
 
-std::vector<Point2> ObstacleMemory::points(const Pose2& pose) const {
-  std::vector<Point2> result;
+std::vector<common::Point2> ObstacleMemory::points(const common::Pose2& pose) const {
+  std::vector<common::Point2> result;
   for (const Scan& scan : scans_)
-    for (const Point2& point : scan.points) result.push_back(toRobotFrame(pose, point));
+    for (const common::Point2& point : scan.points) result.push_back(toRobotFrame(pose, point));
   return result;
 }
 
@@ -106,11 +110,12 @@ namespace {
 // Free distance beyond the footprint's front (`direction` +1) or rear (-1) within its lane. Points beside the
 // footprint in the lane's side margins do not count (driving straight does not bring them closer); points inside
 // the footprint's half on that side give 0.
-double laneClearance(const std::vector<Point2>& obstacles, const PathFollowerOptions& options, double direction) {
+double laneClearance(const std::vector<common::Point2>& obstacles, const PathFollowerOptions& options,
+                     double direction) {
   const double half_length = 0.5 * options.footprint_length, half_width = 0.5 * options.footprint_width;
   const double half_lane = half_width + options.side_margin;
   double clearance = kInfinity;
-  for (const Point2& point : obstacles) {
+  for (const common::Point2& point : obstacles) {
     const double along = direction * point.x();
     if (!point.allFinite() || std::abs(point.y()) > half_lane || along < 0.0 || (along == 0.0 && direction < 0))
       continue;
@@ -124,17 +129,17 @@ double laneClearance(const std::vector<Point2>& obstacles, const PathFollowerOpt
 
 }  // namespace
 
-double frontClearance(const std::vector<Point2>& obstacles, const PathFollowerOptions& options) {
+double frontClearance(const std::vector<common::Point2>& obstacles, const PathFollowerOptions& options) {
   return laneClearance(obstacles, options, 1.0);
 }
 
-double rearClearance(const std::vector<Point2>& obstacles, const PathFollowerOptions& options) {
+double rearClearance(const std::vector<common::Point2>& obstacles, const PathFollowerOptions& options) {
   return laneClearance(obstacles, options, -1.0);
 }
 
 PathFollower::PathFollower(const PathFollowerOptions& options) : options_(options) { validate(options_); }
 
-void PathFollower::setPath(const std::vector<Point2>& path, double time) {
+void PathFollower::setPath(const std::vector<common::Point2>& path, double time) {
   path_ = path;
   closest_index_ = 0;
   recoveries_ = 0;
@@ -146,7 +151,7 @@ void PathFollower::setPath(const std::vector<Point2>& path, double time) {
   state_ = path_.empty() ? FollowerState::kIdle : FollowerState::kFollowing;
 }
 
-void PathFollower::updatePath(const std::vector<Point2>& path) {
+void PathFollower::updatePath(const std::vector<common::Point2>& path) {
   if (path.empty()) return;
   path_ = path;
   closest_index_ = 0;
@@ -163,15 +168,15 @@ void PathFollower::hold(double time) {
   held_since_ = time;
 }
 
-bool PathFollower::withinStall(const Pose2& pose, const Pose2& since) const {
+bool PathFollower::withinStall(const common::Pose2& pose, const common::Pose2& since) const {
   return std::hypot(pose.x - since.x, pose.y - since.y) <= options_.stall_distance &&
-         std::abs(wrapAngle(pose.yaw - since.yaw)) <= options_.stall_angle;
+         std::abs(common::wrapAngle(pose.yaw - since.yaw)) <= options_.stall_angle;
 }
 
-double PathFollower::remainingLength(const Pose2& pose) {
+double PathFollower::remainingLength(const common::Pose2& pose) {
   // The closest path point, searched from the last one on (the robot does not go back along its path); a
   // window keeps a path that passes near itself from being skipped.
-  const Point2 position(pose.x, pose.y);
+  const common::Point2 position(pose.x, pose.y);
   double best = kInfinity;
   size_t best_index = closest_index_;
   double along = 0.0;
@@ -190,7 +195,8 @@ double PathFollower::remainingLength(const Pose2& pose) {
   return remaining;
 }
 
-FollowerStep PathFollower::update(const Pose2& pose, const std::vector<Point2>& obstacles, double time) {
+FollowerStep PathFollower::update(const common::Pose2& pose, const std::vector<common::Point2>& obstacles,
+                                  double time) {
   if (held_) {  // the held time does not count: timers move on by it, the stall watch starts afresh
     const double pause = std::max(0.0, time - held_since_);
     progress_time_ += pause;
@@ -207,7 +213,7 @@ FollowerStep PathFollower::update(const Pose2& pose, const std::vector<Point2>& 
   }
 
   // Goal and progress.
-  const Point2 position(pose.x, pose.y);
+  const common::Point2 position(pose.x, pose.y);
   if ((path_.back() - position).norm() <= options_.goal_tolerance) {
     state_ = step.state = FollowerState::kGoalReached;
     return step;
@@ -260,7 +266,7 @@ FollowerStep PathFollower::update(const Pose2& pose, const std::vector<Point2>& 
     } else {
       // Turn towards the side with more room: the mean lateral position of nearby points tells the crowded side.
       double lateral = 0.0;
-      for (const Point2& point : obstacles)
+      for (const common::Point2& point : obstacles)
         if (point.allFinite() && point.norm() < 1.5) lateral += point.y();
       recovery_turn_sign_ = lateral > 0.0 ? -1.0 : 1.0;
     }
@@ -276,22 +282,22 @@ FollowerStep PathFollower::update(const Pose2& pose, const std::vector<Point2>& 
   return follow(pose, obstacles, step.front_clearance);
 }
 
-bool PathFollower::arcHitsObstacle(const std::vector<Point2>& obstacles, double linear, double angular,
+bool PathFollower::arcHitsObstacle(const std::vector<common::Point2>& obstacles, double linear, double angular,
                                    double max_distance) const {
   if (options_.arc_horizon <= 0.0 || linear <= 0.0) return false;
   const double horizon = std::min(options_.arc_horizon, max_distance / linear);
   const double half_length = 0.5 * options_.footprint_length, half_width = 0.5 * options_.footprint_width;
   const double reach = linear * horizon + std::hypot(half_length, half_width) + options_.side_margin;
-  const auto inside = [&](const Point2& point, double margin) {
+  const auto inside = [&](const common::Point2& point, double margin) {
     return std::abs(point.x()) <= half_length + margin && std::abs(point.y()) <= half_width + margin;
   };
-  std::vector<Point2> near;
-  for (const Point2& point : obstacles)
+  std::vector<common::Point2> near;
+  for (const common::Point2& point : obstacles)
     if (point.allFinite() && point.norm() <= reach) near.push_back(point);
   // Already within the margin of something (a tight door): the arc may not come closer than 70% of the present
   // gap, or nothing could move.
   double gap = std::numeric_limits<double>::infinity();
-  for (const Point2& point : near)
+  for (const common::Point2& point : near)
     gap = std::min(gap, std::hypot(std::max(0.0, std::abs(point.x()) - half_length),
                                    std::max(0.0, std::abs(point.y()) - half_width)));
   const double margin = std::min(options_.side_margin, 0.7 * gap);
@@ -302,18 +308,18 @@ bool PathFollower::arcHitsObstacle(const std::vector<Point2>& obstacles, double 
     const double x = std::abs(angular) > 1e-6 ? linear / angular * std::sin(yaw) : linear * t;
     const double y = std::abs(angular) > 1e-6 ? linear / angular * (1.0 - std::cos(yaw)) : 0.0;
     const double c = std::cos(yaw), s = std::sin(yaw);
-    for (const Point2& point : near) {
+    for (const common::Point2& point : near) {
       const double dx = point.x() - x, dy = point.y() - y;
-      if (inside(Point2(c * dx + s * dy, -s * dx + c * dy), margin)) return true;
+      if (inside(common::Point2(c * dx + s * dy, -s * dx + c * dy), margin)) return true;
     }
   }
   return false;
 }
 
-bool PathFollower::inDoorway(const std::vector<Point2>& obstacles) const {
+bool PathFollower::inDoorway(const std::vector<common::Point2>& obstacles) const {
   const double half_length = 0.5 * options_.footprint_length, half_width = 0.5 * options_.footprint_width;
   bool left = false, right = false;
-  for (const Point2& point : obstacles) {
+  for (const common::Point2& point : obstacles) {
     if (!point.allFinite() || std::abs(point.x()) > half_length) continue;
     if (point.y() > half_width && point.y() <= half_width + options_.doorway_distance) left = true;
     if (point.y() < -half_width && point.y() >= -half_width - options_.doorway_distance) right = true;
@@ -321,18 +327,18 @@ bool PathFollower::inDoorway(const std::vector<Point2>& obstacles) const {
   return left && right;
 }
 
-VelocityCommand PathFollower::turnInPlace(double angular, const std::vector<Point2>& obstacles,
-                                          double front_clearance) const {
+common::VelocityCommand PathFollower::turnInPlace(double angular, const std::vector<common::Point2>& obstacles,
+                                                  double front_clearance) const {
   const double half_length = 0.5 * options_.footprint_length, half_width = 0.5 * options_.footprint_width;
   const double swept_radius = std::hypot(half_length, half_width) + options_.side_margin;
   bool front = false, rear = false;
-  for (const Point2& point : obstacles) {
+  for (const common::Point2& point : obstacles) {
     if (!point.allFinite() || point.norm() >= swept_radius) continue;
     if (std::abs(point.x()) <= half_length && std::abs(point.y()) <= half_width) continue;  // inside: not the turn's fault
     (point.x() >= 0.0 ? front : rear) = true;
   }
   const bool ahead_free = front_clearance > options_.stop_distance;
-  VelocityCommand command;
+  common::VelocityCommand command;
   command.angular = angular;
   if (front && !rear) {
     if (rearClearance(obstacles, options_) > options_.stop_distance) command.linear = -options_.creep_velocity;
@@ -346,19 +352,20 @@ VelocityCommand PathFollower::turnInPlace(double angular, const std::vector<Poin
   return command;
 }
 
-FollowerStep PathFollower::follow(const Pose2& pose, const std::vector<Point2>& obstacles, double clearance) {
+FollowerStep PathFollower::follow(const common::Pose2& pose, const std::vector<common::Point2>& obstacles,
+                                  double clearance) {
   FollowerStep step;
   step.state = state_;
   step.front_clearance = clearance;
   // Pursued point: the first path point at least `lookahead` from the robot after the closest one, else the end.
-  const Point2 position(pose.x, pose.y);
-  Point2 target = path_.back();
+  const common::Point2 position(pose.x, pose.y);
+  common::Point2 target = path_.back();
   for (size_t i = closest_index_; i < path_.size(); ++i)
     if ((path_[i] - position).norm() >= options_.lookahead) {
       target = path_[i];
       break;
     }
-  const Point2 local = toRobotFrame(pose, target);
+  const common::Point2 local = toRobotFrame(pose, target);
   const double heading_error = std::atan2(local.y(), local.x());
   if (std::abs(heading_error) > options_.rotate_in_place_angle) {
     step.command = turnInPlace(std::clamp(options_.heading_gain * heading_error, -options_.max_angular_velocity,
@@ -414,4 +421,4 @@ FollowerStep PathFollower::follow(const Pose2& pose, const std::vector<Point2>& 
   return step;
 }
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::exploration

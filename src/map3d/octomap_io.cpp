@@ -19,7 +19,7 @@
 #include "hidden_rooms/common/input_error.h"
 #include "hidden_rooms/common/label_image.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::map3d {
 
 namespace {
 
@@ -45,7 +45,7 @@ void forColumn(const octomap::OcTreeKey& base, int voxels, Visit visit) {
 // Fills `tree` with the extruded map: free columns first, then occupied ones (a coarser voxel holding both
 // kinds of cells is occupied); ColorOcTree voxels also get their colour.
 template <typename Tree>
-void extrude(const OccupancyGrid& map, const cv::Mat1w& labels, double height, Tree* tree) {
+void extrude(const common::OccupancyGrid& map, const cv::Mat1w& labels, double height, Tree* tree) {
   const double resolution = tree->getResolution();
   const int voxels = std::max(1, static_cast<int>(std::ceil(height / resolution - 1e-9)));
   // The room (label) a wall cell belongs to: the label of a room cell among its 8 neighbours.
@@ -57,14 +57,14 @@ void extrude(const OccupancyGrid& map, const cv::Mat1w& labels, double height, T
         const int8_t value = map.cells(row, col);
         const bool occupied = value >= kOccupiedMin;
         if (value < 0 || (value > kFreeMax && !occupied) || occupied != occupied_pass) continue;
-        const Point2 centre = map.cellCentre(col, row);
+        const common::Point2 centre = map.cellCentre(col, row);
         octomap::OcTreeKey base;
         if (!tree->coordToKeyChecked(octomap::point3d(centre.x(), centre.y(), 0.5 * resolution), base))
-          throw InputError("octomap export", "the map reaches beyond OctoMap's extent at this resolution");
+          throw common::InputError("octomap export", "the map reaches beyond OctoMap's extent at this resolution");
         forColumn(base, voxels, [&](const octomap::OcTreeKey& key) { tree->updateNode(key, occupied, true); });
         if constexpr (std::is_same_v<Tree, octomap::ColorOcTree>) {
           const int label = labels.empty() ? 0 : (occupied ? wall_labels(row, col) : labels(row, col));
-          const cv::Vec3b colour = label > 0 ? roomColour(label) : (occupied ? kWallGrey : kFreeGrey);
+          const cv::Vec3b colour = label > 0 ? common::roomColour(label) : (occupied ? kWallGrey : kFreeGrey);
           forColumn(base, voxels, [&](const octomap::OcTreeKey& key) {
             tree->setNodeColor(key, colour[2], colour[1], colour[0]);  // roomColour is BGR
           });
@@ -78,26 +78,26 @@ void extrude(const OccupancyGrid& map, const cv::Mat1w& labels, double height, T
 
 // Projects the band of `tree` into a grid (see sliceOctomap).
 template <typename Tree>
-OccupancyGrid slice(const Tree& tree, const SliceOptions& options, const std::string& path) {
-  if (tree.size() == 0) throw InputError(path, "the octree is empty");
+common::OccupancyGrid slice(const Tree& tree, const SliceOptions& options, const std::string& path) {
+  if (tree.size() == 0) throw common::InputError(path, "the octree is empty");
   double min_x = 0, min_y = 0, min_z = 0, max_x = 0, max_y = 0, max_z = 0;
   tree.getMetricMin(min_x, min_y, min_z);
   tree.getMetricMax(max_x, max_y, max_z);
   const double resolution = options.resolution > 0.0 ? options.resolution : tree.getResolution();
-  OccupancyGrid grid;
+  common::OccupancyGrid grid;
   grid.resolution = resolution;
-  grid.origin = Point2(min_x, min_y);
+  grid.origin = common::Point2(min_x, min_y);
   const double columns = std::ceil((max_x - min_x) / resolution - kEdge);
   const double rows = std::ceil((max_y - min_y) / resolution - kEdge);
   if (!(columns * rows <= kMaxSliceCells)) {
     std::ostringstream problem;
     problem << "spans " << columns << " x " << rows << " cells at " << resolution
             << " m (at most 1e8): slice it at a coarser resolution";
-    throw InputError(path, problem.str());
+    throw common::InputError(path, problem.str());
   }
   const int width = std::max(1, static_cast<int>(columns));
   const int height = std::max(1, static_cast<int>(rows));
-  grid.cells = cv::Mat_<int8_t>(height, width, OccupancyGrid::kUnknown);
+  grid.cells = cv::Mat_<int8_t>(height, width, common::OccupancyGrid::kUnknown);
   for (auto leaf = tree.begin_leafs(), end = tree.end_leafs(); leaf != end; ++leaf) {
     const double half = 0.5 * leaf.getSize();
     const octomap::point3d centre = leaf.getCoordinate();
@@ -112,9 +112,9 @@ OccupancyGrid slice(const Tree& tree, const SliceOptions& options, const std::st
       for (int col = col_begin; col < col_end; ++col) {
         int8_t& cell = grid.cells(height - 1 - y, col);
         if (occupied)
-          cell = OccupancyGrid::kOccupied;
-        else if (cell == OccupancyGrid::kUnknown)
-          cell = OccupancyGrid::kFree;
+          cell = common::OccupancyGrid::kOccupied;
+        else if (cell == common::OccupancyGrid::kUnknown)
+          cell = common::OccupancyGrid::kFree;
       }
     }
   }
@@ -130,10 +130,10 @@ constexpr int kTreeDepth = 16;  // OctoMap's levels below the root: nodes at thi
 std::istringstream checkedOctomapStream(const std::string& path, bool binary) {
   std::ifstream file(path, std::ios::binary);
   const std::string bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
-  if (file.bad()) throw InputError(path, "cannot be read");
+  if (file.bad()) throw common::InputError(path, "cannot be read");
   const std::string first_line = binary ? "# Octomap OcTree binary file" : "# Octomap OcTree file";
   if (bytes.compare(0, first_line.size(), first_line) != 0)
-    throw InputError(path, "is not an OctoMap file (the first line is not '" + first_line + "')");
+    throw common::InputError(path, "is not an OctoMap file (the first line is not '" + first_line + "')");
 
   // Header: "key value" lines and # comments up to a line "data".
   std::string id;
@@ -155,11 +155,12 @@ std::istringstream checkedOctomapStream(const std::string& path, bool binary) {
     if (key == "res") fields >> resolution;
     line_begin = line_end;
   }
-  if (data == std::string::npos) throw InputError(path, "is not an OctoMap file (no header ending in 'data')");
+  if (data == std::string::npos) throw common::InputError(path, "is not an OctoMap file (no header ending in 'data')");
   if (!(resolution > 0.0) || !std::isfinite(resolution))
-    throw InputError(path, "declares a resolution that is not positive");
+    throw common::InputError(path, "declares a resolution that is not positive");
   if (id != "OcTree" && (binary || id != "ColorOcTree"))
-    throw InputError(path, "holds a tree of type '" + id + "', not an OcTree" + (binary ? "" : " or ColorOcTree"));
+    throw common::InputError(path,
+                             "holds a tree of type '" + id + "', not an OcTree" + (binary ? "" : " or ColorOcTree"));
 
   // The nodes, depth first: a .bt spends 2 bytes on each inner node (2 bits per child: 01 occupied leaf, 10 free
   // leaf, 11 inner node); a .ot spends on each node its value (float log-odds, plus r, g, b for a ColorOcTree) and
@@ -169,7 +170,7 @@ std::istringstream checkedOctomapStream(const std::string& path, bool binary) {
   long long nodes = 1;
   const std::function<void(int)> walk = [&](int depth) {
     if (bytes.size() - at < node_bytes)
-      throw InputError(path, "ends inside its tree (after " + std::to_string(nodes) + " nodes)");
+      throw common::InputError(path, "ends inside its tree (after " + std::to_string(nodes) + " nodes)");
     const auto* node = reinterpret_cast<const unsigned char*>(bytes.data() + at);
     at += node_bytes;
     std::vector<bool> has_children;  // per present child
@@ -182,14 +183,15 @@ std::istringstream checkedOctomapStream(const std::string& path, bool binary) {
       }
     }
     if (!has_children.empty() && depth == kTreeDepth)
-      throw InputError(path, "has nodes deeper than OctoMap's " + std::to_string(kTreeDepth) + " levels");
+      throw common::InputError(path, "has nodes deeper than OctoMap's " + std::to_string(kTreeDepth) + " levels");
     nodes += static_cast<long long>(has_children.size());
     for (const bool inner : has_children)
       if (inner) walk(depth + 1);
   };
   walk(0);
   if (nodes != declared_nodes)
-    throw InputError(path, "declares " + std::to_string(declared_nodes) + " nodes but holds " + std::to_string(nodes));
+    throw common::InputError(
+        path, "declares " + std::to_string(declared_nodes) + " nodes but holds " + std::to_string(nodes));
 
   std::ostringstream header;
   header.precision(17);
@@ -199,20 +201,20 @@ std::istringstream checkedOctomapStream(const std::string& path, bool binary) {
 
 }  // namespace
 
-void exportOctomap(const OccupancyGrid& map, const cv::Mat1w& room_labels, const ExtrusionOptions& options,
+void exportOctomap(const common::OccupancyGrid& map, const cv::Mat1w& room_labels, const ExtrusionOptions& options,
                    const std::string& path) {
-  if (map.empty()) throw InputError("octomap export", "the map is empty");
+  if (map.empty()) throw common::InputError("octomap export", "the map is empty");
   if (!(options.height > 0.0) || !std::isfinite(options.height))
-    throw InputError("octomap export", "the height must be positive");
+    throw common::InputError("octomap export", "the height must be positive");
   if (!(options.resolution >= 0.0) || !std::isfinite(options.resolution))
-    throw InputError("octomap export", "the resolution must be positive (or 0 for the map's)");
+    throw common::InputError("octomap export", "the resolution must be positive (or 0 for the map's)");
   if (!room_labels.empty() && room_labels.size() != map.cells.size())
-    throw InputError("octomap export", "the room labels are not the map's size");
+    throw common::InputError("octomap export", "the room labels are not the map's size");
   const double resolution = options.resolution > 0.0 ? options.resolution : map.resolution;
   const std::string extension = extensionOf(path);
   if (extension != ".ot" && extension != ".bt")
-    throw InputError(path, "unknown OctoMap file type '" + extension + "' (use .bt or .ot)");
-  writeAtomically(path, [&](const std::string& temporary) {
+    throw common::InputError(path, "unknown OctoMap file type '" + extension + "' (use .bt or .ot)");
+  common::writeAtomically(path, [&](const std::string& temporary) {
     bool written = false;
     if (extension == ".ot") {
       octomap::ColorOcTree tree(resolution);
@@ -223,14 +225,14 @@ void exportOctomap(const OccupancyGrid& map, const cv::Mat1w& room_labels, const
       extrude(map, room_labels, options.height, &tree);
       written = tree.writeBinary(temporary);
     }
-    if (!written) throw InputError(path, "cannot be written");
+    if (!written) throw common::InputError(path, "cannot be written");
   });
 }
 
-cv::Mat1w roomLabelsFromYaml(const std::string& rooms_yaml, const OccupancyGrid& map) {
-  const YAML::Node root = loadYamlFile(rooms_yaml, "rooms file");
+cv::Mat1w roomLabelsFromYaml(const std::string& rooms_yaml, const common::OccupancyGrid& map) {
+  const YAML::Node root = common::loadYamlFile(rooms_yaml, "rooms file");
   const YAML::Node rooms = root["rooms"];
-  if (!rooms || !rooms.IsSequence()) throw InputError(rooms_yaml, "has no 'rooms' list");
+  if (!rooms || !rooms.IsSequence()) throw common::InputError(rooms_yaml, "has no 'rooms' list");
   cv::Mat1w labels = cv::Mat1w::zeros(map.height(), map.width());
   for (size_t k = 0; k < rooms.size(); ++k) {
     const YAML::Node room = rooms[k];
@@ -238,46 +240,46 @@ cv::Mat1w roomLabelsFromYaml(const std::string& rooms_yaml, const OccupancyGrid&
     try {
       if (room["placed"] && !room["placed"].as<bool>()) continue;
       const int label = room["label"] ? room["label"].as<int>() : static_cast<int>(k) + 1;
-      if (label <= 0 || label > 65535) throw InputError(rooms_yaml, where + ".label is out of range");
+      if (label <= 0 || label > 65535) throw common::InputError(rooms_yaml, where + ".label is out of range");
       std::vector<cv::Point> polygon;
       for (const YAML::Node& vertex : room["polygon"]) {
-        const Point2 point(vertex[0].as<double>(), vertex[1].as<double>());
-        if (!point.allFinite()) throw InputError(rooms_yaml, where + " has a non-finite vertex");
-        const Point2 image = map.toImage(point);
+        const common::Point2 point(vertex[0].as<double>(), vertex[1].as<double>());
+        if (!point.allFinite()) throw common::InputError(rooms_yaml, where + " has a non-finite vertex");
+        const common::Point2 image = map.toImage(point);
         polygon.emplace_back(static_cast<int>(std::lround(image.x() - 0.5)),
                              static_cast<int>(std::lround(image.y() - 0.5)));
       }
-      if (polygon.size() < 3) throw InputError(rooms_yaml, where + " needs a polygon of at least 3 vertices");
+      if (polygon.size() < 3) throw common::InputError(rooms_yaml, where + " needs a polygon of at least 3 vertices");
       cv::fillPoly(labels, std::vector<std::vector<cv::Point>>{polygon}, cv::Scalar(label));
     } catch (const YAML::Exception& error) {
-      throw InputError(rooms_yaml, where + " is malformed: " + error.msg);
+      throw common::InputError(rooms_yaml, where + " is malformed: " + error.msg);
     }
   }
   return labels;
 }
 
-OccupancyGrid sliceOctomap(const std::string& path, const SliceOptions& options) {
+common::OccupancyGrid sliceOctomap(const std::string& path, const SliceOptions& options) {
   if (!std::isfinite(options.z_min) || !std::isfinite(options.z_max) || options.z_min >= options.z_max)
-    throw InputError("octomap slice", "the band needs z_min < z_max");
+    throw common::InputError("octomap slice", "the band needs z_min < z_max");
   if (!(options.resolution >= 0.0) || !std::isfinite(options.resolution))
-    throw InputError("octomap slice", "the resolution must be positive (or 0 for the tree's)");
-  if (!std::filesystem::is_regular_file(path)) throw InputError(path, "no such file");
+    throw common::InputError("octomap slice", "the resolution must be positive (or 0 for the tree's)");
+  if (!std::filesystem::is_regular_file(path)) throw common::InputError(path, "no such file");
   const std::string extension = extensionOf(path);
   if (extension == ".bt") {
     std::istringstream stream = checkedOctomapStream(path, true);
     octomap::OcTree tree(0.1);
-    if (!tree.readBinary(stream)) throw InputError(path, "is not a readable binary OctoMap (.bt)");
+    if (!tree.readBinary(stream)) throw common::InputError(path, "is not a readable binary OctoMap (.bt)");
     return slice(tree, options, path);
   }
   if (extension == ".ot") {
     std::istringstream stream = checkedOctomapStream(path, false);
     std::unique_ptr<octomap::AbstractOcTree> tree(octomap::AbstractOcTree::read(stream));
-    if (!tree) throw InputError(path, "is not a readable OctoMap (.ot)");
+    if (!tree) throw common::InputError(path, "is not a readable OctoMap (.ot)");
     if (const auto* color = dynamic_cast<const octomap::ColorOcTree*>(tree.get())) return slice(*color, options, path);
     if (const auto* plain = dynamic_cast<const octomap::OcTree*>(tree.get())) return slice(*plain, options, path);
-    throw InputError(path, "holds a " + tree->getTreeType() + ", not an OcTree or ColorOcTree");
+    throw common::InputError(path, "holds a " + tree->getTreeType() + ", not an OcTree or ColorOcTree");
   }
-  throw InputError(path, "unknown OctoMap file type '" + extension + "' (use .bt or .ot)");
+  throw common::InputError(path, "unknown OctoMap file type '" + extension + "' (use .bt or .ot)");
 }
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::map3d

@@ -23,19 +23,21 @@
 
 #include "hidden_rooms/common/input_error.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::mapping {
 
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-mrpt::poses::CPose2D toMrpt(const Pose2& pose) { return mrpt::poses::CPose2D(pose.x, pose.y, pose.yaw); }
-Pose2 fromMrpt(const mrpt::math::TPose3D& pose) { return {pose.x, pose.y, pose.yaw}; }
+mrpt::poses::CPose2D toMrpt(const common::Pose2& pose) { return mrpt::poses::CPose2D(pose.x, pose.y, pose.yaw); }
+common::Pose2 fromMrpt(const mrpt::math::TPose3D& pose) { return {pose.x, pose.y, pose.yaw}; }
 
 // The double a float was written from (0.05f -> 0.05): MRPT keeps the grid's geometry in floats.
 double shortest(float value) { return std::stod(mrpt::format("%.7g", static_cast<double>(value))); }
 
-bool finite(const Pose2& pose) { return std::isfinite(pose.x) && std::isfinite(pose.y) && std::isfinite(pose.yaw); }
+bool finite(const common::Pose2& pose) {
+  return std::isfinite(pose.x) && std::isfinite(pose.y) && std::isfinite(pose.yaw);
+}
 
 // The odometry motion model from the ini's [MotionModel] section (MRPT has no loader for it).
 mrpt::obs::CActionRobotMovement2D::TMotionModelOptions readMotionModel(const mrpt::config::CConfigFileBase& ini,
@@ -51,7 +53,8 @@ mrpt::obs::CActionRobotMovement2D::TMotionModelOptions readMotionModel(const mrp
   g.minStdXY = ini.read_double(section, "minStdXY", g.minStdXY);
   g.minStdPHI = ini.read_double(section, "minStdPHI_deg", g.minStdPHI * 180.0 / kPi) * kPi / 180.0;
   for (double value : {g.a1, g.a2, g.a3, g.a4, g.minStdXY, g.minStdPHI})
-    if (!std::isfinite(value) || value < 0.0) throw InputError(file, "[MotionModel] values must be zero or positive");
+    if (!std::isfinite(value) || value < 0.0)
+      throw common::InputError(file, "[MotionModel] values must be zero or positive");
   return model;
 }
 
@@ -68,7 +71,8 @@ mrpt::maps::COccupancyGridMap2D::TInsertionOptions readPublishedInsertion(
   const auto certain = [](float value) { return value > 0.5f && value < 1.0f; };
   if (!certain(insertion.maxOccupancyUpdateCertainty) ||
       !(insertion.maxFreenessUpdateCertainty == 0.0f || certain(insertion.maxFreenessUpdateCertainty)))
-    throw InputError(file, "[PublishedMap] certainties must be in (0.5, 1) (maxFreenessUpdateCertainty 0: as occupancy)");
+    throw common::InputError(
+        file, "[PublishedMap] certainties must be in (0.5, 1) (maxFreenessUpdateCertainty 0: as occupancy)");
   return insertion;
 }
 
@@ -78,7 +82,7 @@ struct RbpfMapper::Impl {
   std::unique_ptr<mrpt::slam::CMetricMapBuilderRBPF> builder;
   mrpt::obs::CActionRobotMovement2D::TMotionModelOptions motion_model;
   bool started = false;
-  Pose2 last_odometry;
+  common::Pose2 last_odometry;
   int added = 0;
   int inserted = 0;
 
@@ -99,13 +103,13 @@ struct RbpfMapper::Impl {
 
 RbpfMapper::RbpfMapper(const RbpfMapperOptions& options) : impl_(std::make_unique<Impl>()) {
   const std::string& file = options.config_file;
-  if (file.empty()) throw InputError("rbpf config", "no ini file given");
+  if (file.empty()) throw common::InputError("rbpf config", "no ini file given");
   if (!std::filesystem::is_regular_file(file) || !std::ifstream(file).good())
-    throw InputError(file, "cannot read the file");
+    throw common::InputError(file, "cannot read the file");
   mrpt::slam::CMetricMapBuilderRBPF::TConstructionOptions construction;
   try {
     mrpt::config::CConfigFile ini(file);
-    if (!ini.sectionExists(options.section)) throw InputError(file, "no section [" + options.section + "]");
+    if (!ini.sectionExists(options.section)) throw common::InputError(file, "no section [" + options.section + "]");
     construction.loadFromConfigFile(ini, options.section);
     impl_->motion_model = readMotionModel(ini, file);
     for (const auto& initializer : construction.mapsInitializers)
@@ -113,37 +117,37 @@ RbpfMapper::RbpfMapper(const RbpfMapperOptions& options) : impl_(std::make_uniqu
         impl_->published_insertion = readPublishedInsertion(ini, file, grid->insertionOpts);
         break;
       }
-  } catch (const InputError&) {
+  } catch (const common::InputError&) {
     throw;
   } catch (const std::exception& error) {
     // MRPT's messages carry a stack trace; its first line names the missing or bad key.
     std::string message = error.what();
     const size_t newline = message.find('\n');
     if (newline != std::string::npos) message = message.substr(0, newline);
-    throw InputError(file, "bad MRPT RBPF options: " + message);
+    throw common::InputError(file, "bad MRPT RBPF options: " + message);
   }
-  if (construction.PF_options.sampleSize == 0) throw InputError(file, "sampleSize must be positive");
+  if (construction.PF_options.sampleSize == 0) throw common::InputError(file, "sampleSize must be positive");
   if (!(construction.insertionLinDistance >= 0.0f) || !(construction.localizeLinDistance >= 0.0f))
-    throw InputError(file, "insertion and localize distances must be zero or positive");
+    throw common::InputError(file, "insertion and localize distances must be zero or positive");
   mrpt::random::getRandomGenerator().randomize(options.seed);
   try {
     impl_->builder = std::make_unique<mrpt::slam::CMetricMapBuilderRBPF>(construction);
   } catch (const std::exception& error) {
     std::string message = error.what();
-    throw InputError(file, "MRPT cannot build the filter: " + message.substr(0, message.find('\n')));
+    throw common::InputError(file, "MRPT cannot build the filter: " + message.substr(0, message.find('\n')));
   }
   const mrpt::maps::CMultiMetricMap* maps = impl_->builder->getCurrentlyBuiltMetricMap();
   if (maps == nullptr || maps->countMapsByClass<mrpt::maps::COccupancyGridMap2D>() == 0)
-    throw InputError(file, "the maps must include an occupancy grid (occupancyGrid_count = 1)");
+    throw common::InputError(file, "the maps must include an occupancy grid (occupancyGrid_count = 1)");
 }
 
 RbpfMapper::~RbpfMapper() = default;
 
-bool RbpfMapper::addScan(const Pose2& odometry, const RangeScan& scan) {
-  if (scan.ranges.empty()) throw InputError("scan", "has no beams");
+bool RbpfMapper::addScan(const common::Pose2& odometry, const common::RangeScan& scan) {
+  if (scan.ranges.empty()) throw common::InputError("scan", "has no beams");
   if (!finite(scan.sensor_pose) || !std::isfinite(scan.angle_min) || !std::isfinite(scan.angle_increment) ||
       scan.angle_increment == 0.0 || !(scan.range_max > 0.0))
-    throw InputError("scan", "non-finite pose or bad beam geometry");
+    throw common::InputError("scan", "non-finite pose or bad beam geometry");
   // Scan as MRPT wants it: beams from -aperture/2 to +aperture/2 counter-clockwise, the sensor yawed to the
   // middle of the scan (as toMrptScan does for ROS messages).
   const size_t n = scan.ranges.size();
@@ -166,9 +170,9 @@ bool RbpfMapper::addScan(const Pose2& odometry, const RangeScan& scan) {
   return addScan(odometry, observation);
 }
 
-bool RbpfMapper::addScan(const Pose2& odometry, const mrpt::obs::CObservation2DRangeScan& scan) {
-  if (scan.getScanSize() == 0) throw InputError("scan", "has no beams");
-  if (!finite(odometry)) throw InputError("scan", "non-finite odometry pose");
+bool RbpfMapper::addScan(const common::Pose2& odometry, const mrpt::obs::CObservation2DRangeScan& scan) {
+  if (scan.getScanSize() == 0) throw common::InputError("scan", "has no beams");
+  if (!finite(odometry)) throw common::InputError("scan", "non-finite odometry pose");
   Impl& impl = *impl_;
   if (!impl.started) {
     mrpt::poses::CPosePDFGaussian start(toMrpt(odometry));
@@ -228,7 +232,7 @@ size_t RbpfMapper::Impl::mappedParticle() const {
   return 0;
 }
 
-Pose2 RbpfMapper::pose() const {
+common::Pose2 RbpfMapper::pose() const {
   if (!impl_->started) return impl_->last_odometry;
   const std::vector<RbpfParticle> all = particles();
   if (all.empty()) return impl_->last_odometry;
@@ -236,7 +240,9 @@ Pose2 RbpfMapper::pose() const {
   return all[mapped < all.size() ? mapped : 0].pose;
 }
 
-Pose2 RbpfMapper::mapToOdom() const { return composePoses(pose(), invertPose(impl_->last_odometry)); }
+common::Pose2 RbpfMapper::mapToOdom() const {
+  return common::composePoses(pose(), common::invertPose(impl_->last_odometry));
+}
 
 const mrpt::maps::COccupancyGridMap2D& RbpfMapper::Impl::publishedGrid() const {
   const auto& path = builder->mapPDF.m_particles[mappedParticle()].d->robotPath;
@@ -259,24 +265,24 @@ const mrpt::maps::COccupancyGridMap2D& RbpfMapper::Impl::publishedGrid() const {
   return *rendered;
 }
 
-OccupancyGrid RbpfMapper::map() const {
-  OccupancyGrid grid;
+common::OccupancyGrid RbpfMapper::map() const {
+  common::OccupancyGrid grid;
   if (!impl_->started || impl_->inserted_scans.empty()) return grid;
   const mrpt::maps::COccupancyGridMap2D& mrpt_grid = impl_->publishedGrid();
   const int width = static_cast<int>(mrpt_grid.getSizeX()), height = static_cast<int>(mrpt_grid.getSizeY());
   grid.resolution = shortest(mrpt_grid.getResolution());
-  grid.origin = Point2(shortest(mrpt_grid.getXMin()), shortest(mrpt_grid.getYMin()));
+  grid.origin = common::Point2(shortest(mrpt_grid.getXMin()), shortest(mrpt_grid.getYMin()));
   grid.cells.create(height, width);
   for (int y = 0; y < height; ++y) {
     const int row = height - 1 - y;  // MRPT's row 0 is the bottom
     for (int x = 0; x < width; ++x) {
       const float free_probability = mrpt_grid.getCell(x, y);  // 0.5 exactly: never observed
       grid.cells(row, x) = free_probability == 0.5f
-                               ? OccupancyGrid::kUnknown
+                               ? common::OccupancyGrid::kUnknown
                                : static_cast<int8_t>(std::lround(100.0 * (1.0 - free_probability)));
     }
   }
   return grid;
 }
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::mapping

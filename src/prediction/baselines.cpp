@@ -8,7 +8,7 @@
 #include "hidden_rooms/common/input_error.h"
 #include "hidden_rooms/prediction/prediction_support.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::prediction {
 
 namespace {
 
@@ -29,7 +29,7 @@ PredictionResult predictEveryDoor(const PredictionRequest& request, double start
   const auto start_time = std::chrono::steady_clock::now();
   checkUsableMap(request.map);
   PredictionResult result;
-  for (const MapDoor& door : request.doors.doors) {
+  for (const common::MapDoor& door : request.doors.doors) {
     RoomPrediction room;
     room.door_id = door.id;
     room.mask = cv::Mat1b::zeros(request.map.cells.size());
@@ -51,11 +51,11 @@ inline int floorToInt(double value) {
 
 // Unknown cells connected (4-neighbours) to `start` through unknown cells where `allowed` (given over `window`
 // of the map; nothing outside it is allowed) is set. Full-size mask.
-cv::Mat1b connectedUnknown(const OccupancyGrid& map, const cv::Mat1b& allowed, const cv::Rect& window,
+cv::Mat1b connectedUnknown(const common::OccupancyGrid& map, const cv::Mat1b& allowed, const cv::Rect& window,
                            cv::Point start) {
   cv::Mat1b result = cv::Mat1b::zeros(map.cells.size());
   if (!window.contains(start)) return result;
-  const cv::Mat1b passable = (map.cells(window) == OccupancyGrid::kUnknown) & allowed;
+  const cv::Mat1b passable = (map.cells(window) == common::OccupancyGrid::kUnknown) & allowed;
   const cv::Point seed = start - window.tl();
   if (passable(seed) == 0) return result;
   cv::Mat1b mask = cv::Mat1b::zeros(window.height + 2, window.width + 2);
@@ -74,7 +74,7 @@ PredictionResult UnstructuredPredictor::predict(const PredictionRequest& request
   const double radius = resolveParameters(*this, request.parameters).at("start_search_radius");
   checkUsableMap(request.map);
   const cv::Rect box = knownBoundingBox(request.map);
-  return predictEveryDoor(request, radius, [&](const MapDoor&, cv::Point start, RoomPrediction* room) {
+  return predictEveryDoor(request, radius, [&](const common::MapDoor&, cv::Point start, RoomPrediction* room) {
     // Rays from the centre of the start cell, half a cell apart at the farthest corner of the box.
     const cv::Point2d origin(start.x + 0.5, start.y + 0.5);
     const double reach = std::hypot(std::max(origin.x - box.x, box.br().x - origin.x),
@@ -85,7 +85,7 @@ PredictionResult UnstructuredPredictor::predict(const PredictionRequest& request
       const cv::Point2d step(0.5 * std::cos(angle), 0.5 * std::sin(angle));
       for (cv::Point2d p = origin;; p += step) {
         const cv::Point cell(floorToInt(p.x), floorToInt(p.y));
-        if (!box.contains(cell) || request.map.cells(cell) != OccupancyGrid::kUnknown) break;
+        if (!box.contains(cell) || request.map.cells(cell) != common::OccupancyGrid::kUnknown) break;
         room->mask(cell) = 255;
       }
     }
@@ -106,13 +106,14 @@ PredictionResult SkewNormalPredictor::predict(const PredictionRequest& request) 
   const double sigma = parameters.at("skewnormal_sigma");
   const double shape_per_width = parameters.at("skewnormal_shape_per_width");
   const double threshold = parameters.at("skewnormal_p_th");
-  if (sigma <= 0.0) throw InputError("parameters", "skewnormal_sigma must be positive");
-  if (threshold <= 0.0 || threshold >= 1.0) throw InputError("parameters", "skewnormal_p_th must be in (0, 1)");
-  const OccupancyGrid& map = request.map;
+  if (sigma <= 0.0) throw common::InputError("parameters", "skewnormal_sigma must be positive");
+  if (threshold <= 0.0 || threshold >= 1.0) throw common::InputError("parameters", "skewnormal_p_th must be in (0, 1)");
+  const common::OccupancyGrid& map = request.map;
 
-  return predictEveryDoor(request, radius, [&](const MapDoor& door, cv::Point start, RoomPrediction* room) {
+  return predictEveryDoor(request, radius, [&](const common::MapDoor& door, cv::Point start, RoomPrediction* room) {
     // Normal of the door line, pointing to the side of the start cell (the unknown side).
-    Point2 normal = door.orientation == DoorOrientation::kAlongX ? Point2(0, 1) : Point2(1, 0);
+    common::Point2 normal =
+        door.orientation == common::DoorOrientation::kAlongX ? common::Point2(0, 1) : common::Point2(1, 0);
     if ((map.cellCentre(start.x, start.y) - door.position).dot(normal) < 0) normal = -normal;
     const double alpha = shape_per_width * door.width;
     // Density 2 phi(u) Phi(alpha u_n / sigma) in the door frame, evaluated within 4 sigma. The door's axes are
@@ -144,4 +145,4 @@ PredictionResult SkewNormalPredictor::predict(const PredictionRequest& request) 
   });
 }
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::prediction

@@ -13,7 +13,7 @@
 #include "hidden_rooms/prediction/prediction_support.h"
 #include "hidden_rooms/prediction/thesis_predictor.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::prediction {
 
 namespace {
 
@@ -35,7 +35,7 @@ constexpr uint8_t kUnknownPx = 0, kFreePx = 1, kOccupiedPx = 2;
 constexpr int8_t kOccupiedFrom = 50;
 constexpr double kWallDrift = 0.15;  // m: how far past the door's first unknown row a tilted wall may reach
 
-cv::Mat1b statesOf(const OccupancyGrid& map) {
+cv::Mat1b statesOf(const common::OccupancyGrid& map) {
   cv::Mat1b states(map.cells.size(), kUnknownPx);
   states.setTo(kFreePx, map.cells >= 0);
   states.setTo(kOccupiedPx, map.cells >= kOccupiedFrom);
@@ -320,8 +320,8 @@ double neighbourDepth(const Frame& f, double resolution, const Parameters& P, co
 }
 
 // The image pixel of a door's position.
-cv::Point doorPixel(const OccupancyGrid& map, const MapDoor& door) {
-  const Point2 image = map.toImage(door.position);
+cv::Point doorPixel(const common::OccupancyGrid& map, const common::MapDoor& door) {
+  const common::Point2 image = map.toImage(door.position);
   return {static_cast<int>(std::floor(image.x())), static_cast<int>(std::floor(image.y()))};
 }
 
@@ -367,7 +367,7 @@ void clipToKnownOutline(const cv::Mat1b& known, const cv::Point& door, int reach
   (*mask)(room).setTo(0, outside);
 }
 
-double dominantWallAngle(const OccupancyGrid& map) {
+double dominantWallAngle(const common::OccupancyGrid& map) {
   // Only around the occupied cells (the blur and the gradients vanish 20 pixels away from them).
   const cv::Mat1b occupied_cells = map.cells >= kOccupiedFrom;
   const cv::Rect around = cv::boundingRect(occupied_cells);
@@ -427,7 +427,7 @@ double dominantWallAngle(const OccupancyGrid& map) {
   return angle;
 }
 
-double unseenWallThickness(const OccupancyGrid& map) { return unseenWallMetres(statesOf(map), map.resolution); }
+double unseenWallThickness(const common::OccupancyGrid& map) { return unseenWallMetres(statesOf(map), map.resolution); }
 
 std::map<std::string, double> DefaultPredictor::defaultParameters() const {
   std::map<std::string, double> parameters = layoutParameters(LayoutOptions());  // for the grown rooms
@@ -474,18 +474,18 @@ WorkingImage orientedStates(const cv::Mat1b& map_states, double angle, const Par
 // extent (lateralExtent); a door that cannot be placed keeps ok = false and its problem.
 std::vector<DoorFrame> framedDoors(const PredictionRequest& request, const Parameters& P, const WorkingImage& work,
                                    const Frame& f) {
-  const OccupancyGrid& map = request.map;
+  const common::OccupancyGrid& map = request.map;
   const double resolution = map.resolution;
   std::vector<DoorFrame> doors(request.doors.doors.size());
   for (size_t i = 0; i < doors.size(); ++i) {
-    const MapDoor& door = request.doors.doors[i];
+    const common::MapDoor& door = request.doors.doors[i];
     DoorFrame& d = doors[i];
     cv::Point unused;
     if (!nearestUnknownCell(map, door.position, P.start_search_radius, &unused, &d.problem)) continue;
-    const Point2 image = map.toImage(door.position);
+    const common::Point2 image = map.toImage(door.position);
     const cv::Point2d q = applyAffine(work.forward, cv::Point2d(image.x(), image.y()));
     d.p = cv::Point(static_cast<int>(std::floor(q.x)), static_cast<int>(std::floor(q.y)));
-    d.a = door.orientation == DoorOrientation::kAlongX ? cv::Point(1, 0) : cv::Point(0, 1);
+    d.a = door.orientation == common::DoorOrientation::kAlongX ? cv::Point(1, 0) : cv::Point(0, 1);
     d.n = cv::Point(d.a.y, d.a.x);
     d.half_width = std::max(1, static_cast<int>(0.5 * door.width / resolution));
     placeDoor(f, resolution, P, &d);
@@ -676,7 +676,7 @@ std::vector<cv::Mat1b> roomMasks(const Frame& f, const std::vector<DoorFrame>& d
 std::vector<RoomPrediction> mapFrameRooms(const PredictionRequest& request, const WorkingImage& work, double angle,
                                           const std::vector<DoorFrame>& doors, const std::vector<cv::Rect>& rects,
                                           const std::vector<cv::Mat1b>& masks, const cv::Mat1b& map_known) {
-  const OccupancyGrid& map = request.map;
+  const common::OccupancyGrid& map = request.map;
   const double resolution = map.resolution;
   std::vector<RoomPrediction> rooms;
   for (size_t i = 0; i < doors.size(); ++i) {
@@ -740,7 +740,7 @@ PredictionResult DefaultPredictor::predict(const PredictionRequest& request) con
   if (P.start_search_radius <= 0.0 || P.wall_gap < 0.0 || P.max_extent <= 0.0 || P.neighbour_reach < 0.0 ||
       P.min_depth < 0.0 || P.min_rotation < 0.0 || P.bounded_fraction < 0.0 || P.bounded_fraction > 1.0 ||
       P.grown_area_ratio < 0.0 || P.stub_length < 0.0 || P.outline_reach < 0.0 || std::isnan(P.wall_margin))
-    throw InputError("parameters", "default_* parameters out of range");
+    throw common::InputError("parameters", "default_* parameters out of range");
 
   // The grown rooms: the thesis's growth with its own constants on the layout this request configures. It does
   // not depend on the rectangles, so it runs on a second thread meanwhile.
@@ -754,7 +754,7 @@ PredictionResult DefaultPredictor::predict(const PredictionRequest& request) con
 
   const double angle = dominantWallAngle(request.map);
   const cv::Mat1b states = statesOf(request.map);
-  const cv::Mat1b known = request.map.cells != OccupancyGrid::kUnknown;
+  const cv::Mat1b known = request.map.cells != common::OccupancyGrid::kUnknown;
   std::vector<RoomPrediction> rectangles = rectangleRooms(request, P, angle, states, known);
   const double resolution = request.map.resolution;
   // Cells within the wall margin of an occupied cell: the unseen rest of the walls the robot saw from one side.
@@ -826,4 +826,4 @@ PredictionResult DefaultPredictor::predict(const PredictionRequest& request) con
   return result;
 }
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::prediction

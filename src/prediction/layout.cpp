@@ -10,14 +10,14 @@
 #include "hidden_rooms/common/parameter_table.h"
 #include "hidden_rooms/prediction/layout_debug.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::prediction {
 
 // ---------------------------------------------------------------------------------------------------------
 // Options
 
 namespace {
 
-using ParameterField = hidden_rooms::ParameterField<LayoutOptions>;
+using ParameterField = hidden_rooms::common::ParameterField<LayoutOptions>;
 
 // config/layout.yaml's order.
 const std::vector<ParameterField>& parameterFields() {
@@ -49,16 +49,16 @@ const std::vector<ParameterField>& parameterFields() {
 }  // namespace
 
 const std::vector<std::string>& layoutParameterNames() {
-  static const std::vector<std::string> names = parameterNames(parameterFields());
+  static const std::vector<std::string> names = common::parameterNames(parameterFields());
   return names;
 }
 
 std::map<std::string, double> layoutParameters(const LayoutOptions& options) {
-  return parameterValues(parameterFields(), options);
+  return common::parameterValues(parameterFields(), options);
 }
 
 void applyLayoutParameters(const std::map<std::string, double>& parameters, LayoutOptions* options) {
-  applyParameterValues(parameterFields(), parameters, options);
+  common::applyParameterValues(parameterFields(), parameters, options);
   validateLayoutOptions(*options);
 }
 
@@ -66,7 +66,7 @@ LayoutOptions layoutOptionsFromParameters(const std::map<std::string, double>& p
   const std::vector<std::string>& names = layoutParameterNames();
   for (const auto& entry : parameters)
     if (std::find(names.begin(), names.end(), entry.first) == names.end())
-      throw InputError("parameters", "unknown parameter '" + entry.first + "'");
+      throw common::InputError("parameters", "unknown parameter '" + entry.first + "'");
   LayoutOptions options;
   applyLayoutParameters(parameters, &options);
   return options;
@@ -74,31 +74,31 @@ LayoutOptions layoutOptionsFromParameters(const std::map<std::string, double>& p
 
 void validateLayoutOptions(const LayoutOptions& o) {
   constexpr double kInf = std::numeric_limits<double>::infinity();
-  requireFiniteParameters(parameterFields(), o);
-  requireParameterInRange("binary_threshold", o.binary_threshold, {0, 255, false, false});
-  requireParameterInRange("canny_low_threshold", o.canny_low_threshold, {0, kInf, false, true});
-  requireParameterInRange("canny_high_threshold", o.canny_high_threshold, {0, kInf, false, true});
+  common::requireFiniteParameters(parameterFields(), o);
+  common::requireParameterInRange("binary_threshold", o.binary_threshold, {0, 255, false, false});
+  common::requireParameterInRange("canny_low_threshold", o.canny_low_threshold, {0, kInf, false, true});
+  common::requireParameterInRange("canny_high_threshold", o.canny_high_threshold, {0, kInf, false, true});
   if (o.canny_aperture != 3 && o.canny_aperture != 5 && o.canny_aperture != 7)
-    throw InputError("parameters",
-                     "parameter 'canny_aperture' must be 3, 5 or 7, got " + formatNumber(o.canny_aperture));
-  requireParameterInRange("hough_rho", o.hough_rho, {0, kInf, true, true});
-  requireParameterInRange("hough_theta", o.hough_theta, {0, CV_PI, true, true});
-  requireParameterInRange("hough_threshold", o.hough_threshold, {0, kInf, true, true});
-  requireParameterInRange("hough_min_line_length", o.hough_min_line_length, {0, kInf, false, true});
-  requireParameterInRange("hough_max_line_gap", o.hough_max_line_gap, {0, kInf, false, true});
-  requireParameterInRange("angular_bandwidth", o.angular_bandwidth, {0, CV_PI / 2, true, true});
-  requireParameterInRange("wall_cluster_distance", o.wall_cluster_distance, {0, kInf, false, true});
-  requireParameterInRange("line_merge_distance", o.line_merge_distance, {0, kInf, false, true});
+    throw common::InputError(
+        "parameters", "parameter 'canny_aperture' must be 3, 5 or 7, got " + common::formatNumber(o.canny_aperture));
+  common::requireParameterInRange("hough_rho", o.hough_rho, {0, kInf, true, true});
+  common::requireParameterInRange("hough_theta", o.hough_theta, {0, CV_PI, true, true});
+  common::requireParameterInRange("hough_threshold", o.hough_threshold, {0, kInf, true, true});
+  common::requireParameterInRange("hough_min_line_length", o.hough_min_line_length, {0, kInf, false, true});
+  common::requireParameterInRange("hough_max_line_gap", o.hough_max_line_gap, {0, kInf, false, true});
+  common::requireParameterInRange("angular_bandwidth", o.angular_bandwidth, {0, CV_PI / 2, true, true});
+  common::requireParameterInRange("wall_cluster_distance", o.wall_cluster_distance, {0, kInf, false, true});
+  common::requireParameterInRange("line_merge_distance", o.line_merge_distance, {0, kInf, false, true});
   if (o.door_pair_lines != 0 && o.door_pair_lines != 1)
-    throw InputError("parameters",
-                     "parameter 'door_pair_lines' must be 0 or 1, got " + formatNumber(o.door_pair_lines));
-  requireParameterInRange("boundary_offset", o.boundary_offset, {0, kInf, true, true});
-  requireParameterInRange("out_unknown_fraction", o.out_unknown_fraction, {0, 1, false, false});
-  requireParameterInRange("wall_coverage_band", o.wall_coverage_band, {0, kInf, false, true});
-  requireParameterInRange("affinity_sigma", o.affinity_sigma, {0, kInf, true, true});
-  requireParameterInRange("dbscan_eps", o.dbscan_eps, {0, 1, true, true});
-  requireParameterInRange("dbscan_min_points", o.dbscan_min_points, {1, kInf, false, true, true});
-  requireParameterInRange("door_search_radius", o.door_search_radius, {0, kInf, true, true});
+    throw common::InputError(
+        "parameters", "parameter 'door_pair_lines' must be 0 or 1, got " + common::formatNumber(o.door_pair_lines));
+  common::requireParameterInRange("boundary_offset", o.boundary_offset, {0, kInf, true, true});
+  common::requireParameterInRange("out_unknown_fraction", o.out_unknown_fraction, {0, 1, false, false});
+  common::requireParameterInRange("wall_coverage_band", o.wall_coverage_band, {0, kInf, false, true});
+  common::requireParameterInRange("affinity_sigma", o.affinity_sigma, {0, kInf, true, true});
+  common::requireParameterInRange("dbscan_eps", o.dbscan_eps, {0, 1, true, true});
+  common::requireParameterInRange("dbscan_min_points", o.dbscan_min_points, {1, kInf, false, true, true});
+  common::requireParameterInRange("door_search_radius", o.door_search_radius, {0, kInf, true, true});
 }
 
 // ---------------------------------------------------------------------------------------------------------
@@ -145,19 +145,19 @@ bool CellGrid::sharedEdge(int a, int b, ImageSegment* edge) const {
   if (a > b) std::swap(a, b);
   const int ia = column(a), ja = row(a), ib = column(b), jb = row(b);
   if (ja == jb && ib == ia + 1) {
-    edge->a = Point2(xs[ib], ys[ja]);
-    edge->b = Point2(xs[ib], ys[ja + 1]);
+    edge->a = common::Point2(xs[ib], ys[ja]);
+    edge->b = common::Point2(xs[ib], ys[ja + 1]);
     return true;
   }
   if (ia == ib && jb == ja + 1) {
-    edge->a = Point2(xs[ia], ys[jb]);
-    edge->b = Point2(xs[ia + 1], ys[jb]);
+    edge->a = common::Point2(xs[ia], ys[jb]);
+    edge->b = common::Point2(xs[ia + 1], ys[jb]);
     return true;
   }
   return false;
 }
 
-int CellGrid::cellAt(const Point2& p) const {
+int CellGrid::cellAt(const common::Point2& p) const {
   if (columns() == 0 || rows() == 0) return -1;
   if (p.x() < xs.front() || p.x() >= xs.back() || p.y() < ys.front() || p.y() >= ys.back()) return -1;
   const int i = static_cast<int>(std::upper_bound(xs.begin(), xs.end(), p.x()) - xs.begin()) - 1;
@@ -225,7 +225,7 @@ void clusterAngles(double bandwidth, Layout* layout) {
       if (weight <= 0) break;
       const double next = (moment_sum[hi] - moment_sum[lo]) / weight;
       const bool converged = std::abs(next - mode) < 1e-7;
-      mode = angleModuloPi(next);
+      mode = common::angleModuloPi(next);
       if (converged) break;
     }
     return mode;
@@ -256,7 +256,7 @@ void clusterAngles(double bandwidth, Layout* layout) {
   for (const auto& group : groups) {
     double offset = 0;
     for (double mode : group) offset += angleDifference(mode, group.front());
-    merged.push_back(angleModuloPi(group.front() + offset / group.size()));
+    merged.push_back(common::angleModuloPi(group.front() + offset / group.size()));
   }
 
   // Assign, then recentre each mode on its members.
@@ -275,7 +275,7 @@ void clusterAngles(double bandwidth, Layout* layout) {
   for (size_t m = 0; m < merged.size(); ++m) {
     if (member_weight[m] <= 0) continue;
     renumber[m] = static_cast<int>(layout->angular_modes.size());
-    layout->angular_modes.push_back(angleModuloPi(merged[m] + offset_sum[m] / member_weight[m]));
+    layout->angular_modes.push_back(common::angleModuloPi(merged[m] + offset_sum[m] / member_weight[m]));
   }
   for (int& cluster : layout->segment_angular_cluster) cluster = renumber[cluster];
 }
@@ -290,8 +290,8 @@ void clusterWalls(double max_spread, Layout* layout) {
   layout->walls.clear();
   for (int cluster = 0; cluster < static_cast<int>(layout->angular_modes.size()); ++cluster) {
     const double mode = layout->angular_modes[cluster];
-    const Point2 along(std::cos(mode), std::sin(mode));
-    const Point2 across(-along.y(), along.x());
+    const common::Point2 along(std::cos(mode), std::sin(mode));
+    const common::Point2 across(-along.y(), along.x());
     std::vector<std::pair<double, int>> offsets;  // (offset, segment)
     for (int s = 0; s < static_cast<int>(layout->segments.size()); ++s) {
       if (layout->segment_angular_cluster[s] != cluster) continue;
@@ -311,7 +311,7 @@ void clusterWalls(double max_spread, Layout* layout) {
         wall.segments.push_back(offsets[k].second);
         weighted_offset += segment.length() * offsets[k].first;
         total_length += segment.length();
-        for (const Point2& p : {segment.a, segment.b}) {
+        for (const common::Point2& p : {segment.a, segment.b}) {
           t_min = std::min(t_min, along.dot(p));
           t_max = std::max(t_max, along.dot(p));
         }
@@ -379,8 +379,8 @@ std::vector<ExtendedLine> wallLines(const Layout& layout, double merge_distance)
   std::vector<ExtendedLine> horizontal, vertical;
   for (int w = 0; w < static_cast<int>(layout.walls.size()); ++w) {
     const ImageSegment& segment = layout.walls[w].segment;
-    const Point2 middle = 0.5 * (segment.a + segment.b);
-    const Point2 direction = segment.b - segment.a;
+    const common::Point2 middle = 0.5 * (segment.a + segment.b);
+    const common::Point2 direction = segment.b - segment.a;
     ExtendedLine line;
     line.source = LineSource::kWall;
     line.wall = w;
@@ -405,12 +405,12 @@ std::vector<ExtendedLine> wallLines(const Layout& layout, double merge_distance)
 // vertical line strictly between their x. When no line of that axis lies strictly between them, one is added through
 // their midpoint (unless a line already lies within the merge distance of it). Lines added for earlier pairs count for
 // later pairs. Only lines strictly inside the boundary are added.
-void addDoorPairLines(const std::vector<Point2>& doors, const cv::Rect& boundary, double merge_distance,
+void addDoorPairLines(const std::vector<common::Point2>& doors, const cv::Rect& boundary, double merge_distance,
                       std::vector<ExtendedLine>* lines) {
   for (size_t i = 0; i < doors.size(); ++i)
     for (size_t e = i + 1; e < doors.size(); ++e) {
-      const Point2& a = doors[i];
-      const Point2& b = doors[e];
+      const common::Point2& a = doors[i];
+      const common::Point2& b = doors[e];
       const bool horizontal = std::abs(a.x() - b.x()) < std::abs(a.y() - b.y());
       const LineAxis axis = horizontal ? LineAxis::kHorizontal : LineAxis::kVertical;
       const double low = horizontal ? std::min(a.y(), b.y()) : std::min(a.x(), b.x());
@@ -467,7 +467,7 @@ double coveredFraction(const std::vector<int>& prefix, int from, int to) {
   return static_cast<double>(prefix[b] - prefix[a]) / (to - from);
 }
 
-void buildGrid(const OccupancyGrid& map, const LayoutOptions& options, Layout* layout) {
+void buildGrid(const common::OccupancyGrid& map, const LayoutOptions& options, Layout* layout) {
   CellGrid& grid = layout->grid;
   grid = CellGrid();
   for (const ExtendedLine& line : layout->lines)
@@ -479,7 +479,7 @@ void buildGrid(const OccupancyGrid& map, const LayoutOptions& options, Layout* l
 
   const cv::Rect image(0, 0, map.width(), map.height());
   cv::Mat1i unknown_integral;
-  cv::integral(cv::Mat1b(map.cells == OccupancyGrid::kUnknown) / 255, unknown_integral, CV_32S);
+  cv::integral(cv::Mat1b(map.cells == common::OccupancyGrid::kUnknown) / 255, unknown_integral, CV_32S);
   const int columns = grid.columns(), rows = grid.rows();
   grid.cells.resize(static_cast<size_t>(columns) * rows);
   for (int j = 0; j < rows; ++j)
@@ -497,7 +497,7 @@ void buildGrid(const OccupancyGrid& map, const LayoutOptions& options, Layout* l
     }
 
   // Wall fraction of every inner edge: the share of its pixels with an occupied pixel within the band.
-  const cv::Mat1b occupied = cv::Mat1b(map.cells == OccupancyGrid::kOccupied) / 255;
+  const cv::Mat1b occupied = cv::Mat1b(map.cells == common::OccupancyGrid::kOccupied) / 255;
   const int band = toPixels(options.wall_coverage_band, map.resolution, 1);
   grid.right_wall.assign(grid.cells.size(), 0.0);
   grid.below_wall.assign(grid.cells.size(), 0.0);
@@ -568,9 +568,11 @@ int segmentRooms(const LayoutOptions& options, CellGrid* grid) {
 // to the door line (an O door lies on a horizontal edge, a V door on a vertical one) and falling back to the other
 // orientation when no parallel edge is within the search radius.
 
-double distanceToImageSegment(const Point2& p, const ImageSegment& s) { return distanceToSegment(p, s.a, s.b); }
+double distanceToImageSegment(const common::Point2& p, const ImageSegment& s) {
+  return common::distanceToSegment(p, s.a, s.b);
+}
 
-std::vector<DoorStart> placeDoors(const OccupancyGrid& map, const std::vector<MapDoor>& doors,
+std::vector<DoorStart> placeDoors(const common::OccupancyGrid& map, const std::vector<common::MapDoor>& doors,
                                   const LayoutOptions& options, const CellGrid& grid) {
   struct Candidate {
     int out_cell, in_cell;
@@ -592,18 +594,18 @@ std::vector<DoorStart> placeDoors(const OccupancyGrid& map, const std::vector<Ma
 
   const double radius_pixels = toPixelDistance(options.door_search_radius, map.resolution);
   std::vector<DoorStart> starts;
-  for (const MapDoor& door : doors) {
+  for (const common::MapDoor& door : doors) {
     DoorStart start;
     start.door_id = door.id;
     int col = 0, row = 0;
     if (!map.cellOf(door.position, &col, &row)) {
-      start.problem = "door position (" + formatNumber(door.position.x()) + ", " + formatNumber(door.position.y()) +
-                      ") is outside the map";
+      start.problem = "door position (" + common::formatNumber(door.position.x()) + ", " +
+                      common::formatNumber(door.position.y()) + ") is outside the map";
       starts.push_back(start);
       continue;
     }
-    const Point2 p = map.toImage(door.position);
-    const bool door_horizontal = door.orientation == DoorOrientation::kAlongX;
+    const common::Point2 p = map.toImage(door.position);
+    const bool door_horizontal = door.orientation == common::DoorOrientation::kAlongX;
     const Candidate* best = nullptr;
     double best_distance = std::numeric_limits<double>::infinity();
     for (bool parallel_only : {true, false}) {
@@ -619,7 +621,7 @@ std::vector<DoorStart> placeDoors(const OccupancyGrid& map, const std::vector<Ma
     }
     if (best == nullptr) {
       start.problem = "no cell edge between explored and unknown space within " +
-                      formatNumber(options.door_search_radius) + " m of the door";
+                      common::formatNumber(options.door_search_radius) + " m of the door";
       starts.push_back(start);
       continue;
     }
@@ -627,8 +629,8 @@ std::vector<DoorStart> placeDoors(const OccupancyGrid& map, const std::vector<Ma
     start.start_cell = best->out_cell;
     start.explored_cell = best->in_cell;
     start.edge = best->edge;
-    const Point2 centre = 0.5 * (best->edge.a + best->edge.b);
-    start.position = map.origin + map.resolution * Point2(centre.x(), map.height() - centre.y());
+    const common::Point2 centre = 0.5 * (best->edge.a + best->edge.b);
+    start.position = map.origin + map.resolution * common::Point2(centre.x(), map.height() - centre.y());
     start.distance = best_distance * map.resolution;
     starts.push_back(start);
   }
@@ -639,11 +641,11 @@ std::vector<DoorStart> placeDoors(const OccupancyGrid& map, const std::vector<Ma
 
 // ---------------------------------------------------------------------------------------------------------
 
-Layout analyzeLayout(const OccupancyGrid& map, const std::vector<MapDoor>& closed_doors, const LayoutOptions& options,
-                     const std::string& debug_dir) {
-  if (map.empty()) throw InputError("map", "the map is empty");
+Layout analyzeLayout(const common::OccupancyGrid& map, const std::vector<common::MapDoor>& closed_doors,
+                     const LayoutOptions& options, const std::string& debug_dir) {
+  if (map.empty()) throw common::InputError("map", "the map is empty");
   if (!(map.resolution > 0.0) || !std::isfinite(map.resolution))
-    throw InputError("map", "resolution must be positive");
+    throw common::InputError("map", "resolution must be positive");
   validateLayoutOptions(options);
   const double resolution = map.resolution;
 
@@ -664,8 +666,8 @@ Layout analyzeLayout(const OccupancyGrid& map, const std::vector<MapDoor>& close
                   toPixelDistance(options.hough_max_line_gap, resolution));
   for (const cv::Vec4i& h : hough) {
     ImageSegment segment;  // pixel centres
-    segment.a = Point2(h[0] + 0.5, h[1] + 0.5);
-    segment.b = Point2(h[2] + 0.5, h[3] + 0.5);
+    segment.a = common::Point2(h[0] + 0.5, h[1] + 0.5);
+    segment.b = common::Point2(h[2] + 0.5, h[3] + 0.5);
     layout.segments.push_back(segment);
   }
 
@@ -678,7 +680,7 @@ Layout analyzeLayout(const OccupancyGrid& map, const std::vector<MapDoor>& close
   } else {
     double x0 = std::numeric_limits<double>::infinity(), y0 = x0, x1 = -x0, y1 = -x0;
     for (const ImageSegment& s : layout.segments)
-      for (const Point2& p : {s.a, s.b}) {
+      for (const common::Point2& p : {s.a, s.b}) {
         x0 = std::min(x0, p.x());
         y0 = std::min(y0, p.y());
         x1 = std::max(x1, p.x());
@@ -695,8 +697,8 @@ Layout analyzeLayout(const OccupancyGrid& map, const std::vector<MapDoor>& close
   const double merge_distance = toPixelDistance(options.line_merge_distance, resolution);
   std::vector<ExtendedLine> lines = wallLines(layout, merge_distance);
   if (options.door_pair_lines != 0) {
-    std::vector<Point2> door_points;
-    for (const MapDoor& door : closed_doors) {
+    std::vector<common::Point2> door_points;
+    for (const common::MapDoor& door : closed_doors) {
       int col = 0, row = 0;
       if (map.cellOf(door.position, &col, &row)) door_points.push_back(map.toImage(door.position));
     }
@@ -727,4 +729,4 @@ Layout analyzeLayout(const OccupancyGrid& map, const std::vector<MapDoor>& close
   return layout;
 }
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::prediction

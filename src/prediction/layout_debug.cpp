@@ -9,7 +9,7 @@
 #include "hidden_rooms/common/image_io.h"
 #include "hidden_rooms/common/input_error.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::prediction {
 
 namespace {
 
@@ -43,7 +43,7 @@ class DebugCanvas {
     return canvas;
   }
 
-  cv::Point at(const Point2& p) const {
+  cv::Point at(const common::Point2& p) const {
     return cv::Point(static_cast<int>(std::lround(p.x())), static_cast<int>(std::lround(p.y()))) + offset_;
   }
   cv::Rect at(const cv::Rect& r) const { return cv::Rect(r.tl() + offset_, r.size()) & cv::Rect(cv::Point(), size_); }
@@ -57,8 +57,10 @@ class DebugCanvas {
   void drawGridLines(const Layout& layout, cv::Mat3b* canvas, const cv::Scalar& colour) const {
     const CellGrid& grid = layout.grid;
     if (grid.columns() == 0 || grid.rows() == 0) return;
-    for (int x : grid.xs) cv::line(*canvas, at(Point2(x, grid.ys.front())), at(Point2(x, grid.ys.back())), colour, 1);
-    for (int y : grid.ys) cv::line(*canvas, at(Point2(grid.xs.front(), y)), at(Point2(grid.xs.back(), y)), colour, 1);
+    for (int x : grid.xs)
+      cv::line(*canvas, at(common::Point2(x, grid.ys.front())), at(common::Point2(x, grid.ys.back())), colour, 1);
+    for (int y : grid.ys)
+      cv::line(*canvas, at(common::Point2(grid.xs.front(), y)), at(common::Point2(grid.xs.back(), y)), colour, 1);
   }
 
  private:
@@ -69,7 +71,7 @@ class DebugCanvas {
 
 void writeImage(const std::string& dir, const std::string& name, const cv::Mat& image) {
   const std::string path = (std::filesystem::path(dir) / name).string();
-  hidden_rooms::writeImage(path, image);
+  hidden_rooms::common::writeImage(path, image);
 }
 
 void blend(cv::Mat3b* canvas, const cv::Rect& rect, const cv::Scalar& colour, double alpha) {
@@ -96,7 +98,7 @@ cv::Mat3b angularClustersImage(const DebugCanvas& canvas, const Layout& layout) 
   for (int m = 0; m < static_cast<int>(layout.angular_modes.size()); ++m) {
     double degrees = layout.angular_modes[m] * 180.0 / CV_PI;  // shown in [-45, 135): 179.9 as -0.1
     if (degrees >= 135.0) degrees -= 180.0;
-    cv::putText(angular, formatNumber(std::round(degrees * 10) / 10 + 0.0) + " deg", cv::Point(5, 15 + 15 * m),
+    cv::putText(angular, common::formatNumber(std::round(degrees * 10) / 10 + 0.0) + " deg", cv::Point(5, 15 + 15 * m),
                 cv::FONT_HERSHEY_SIMPLEX, 0.4, paletteColour(m), 1);
   }
   return angular;
@@ -116,8 +118,8 @@ cv::Mat3b wallsImage(const DebugCanvas& canvas, const Layout& layout) {
 }
 
 // extended_lines.png: the extended lines coloured by source (with a legend) and the closed doors as red circles.
-cv::Mat3b extendedLinesImage(const DebugCanvas& canvas, const OccupancyGrid& map, const std::vector<MapDoor>& doors,
-                             const Layout& layout) {
+cv::Mat3b extendedLinesImage(const DebugCanvas& canvas, const common::OccupancyGrid& map,
+                             const std::vector<common::MapDoor>& doors, const Layout& layout) {
   const CellGrid& grid = layout.grid;
   const bool has_grid = grid.columns() > 0 && grid.rows() > 0;
   cv::Mat3b lines = canvas.map(0.5);
@@ -127,11 +129,13 @@ cv::Mat3b extendedLinesImage(const DebugCanvas& canvas, const OccupancyGrid& map
                                 : line.source == LineSource::kDoorPair ? cv::Scalar(200, 0, 200)
                                                                        : cv::Scalar(0, 160, 0);
       const bool horizontal = line.axis == LineAxis::kHorizontal;
-      const Point2 a = horizontal ? Point2(grid.xs.front(), line.position) : Point2(line.position, grid.ys.front());
-      const Point2 b = horizontal ? Point2(grid.xs.back(), line.position) : Point2(line.position, grid.ys.back());
+      const common::Point2 a =
+          horizontal ? common::Point2(grid.xs.front(), line.position) : common::Point2(line.position, grid.ys.front());
+      const common::Point2 b =
+          horizontal ? common::Point2(grid.xs.back(), line.position) : common::Point2(line.position, grid.ys.back());
       cv::line(lines, canvas.at(a), canvas.at(b), colour, 1);
     }
-  for (const MapDoor& door : doors)
+  for (const common::MapDoor& door : doors)
     cv::circle(lines, canvas.at(map.toImage(door.position)), 4, cv::Scalar(0, 0, 255), 2);
   cv::putText(lines, "wall", cv::Point(5, 15), cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(200, 80, 0), 1);
   cv::putText(lines, "door pair", cv::Point(5, 30), cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(200, 0, 200), 1);
@@ -169,8 +173,8 @@ cv::Mat3b roomsImage(const DebugCanvas& canvas, const Layout& layout) {
 
 // start_cells.png: per door its start cell tinted in its colour and its edge in red, or a red cross where it was
 // not placed; each labelled with its id.
-cv::Mat3b startCellsImage(const DebugCanvas& canvas, const OccupancyGrid& map, const std::vector<MapDoor>& doors,
-                          const Layout& layout) {
+cv::Mat3b startCellsImage(const DebugCanvas& canvas, const common::OccupancyGrid& map,
+                          const std::vector<common::MapDoor>& doors, const Layout& layout) {
   cv::Mat3b starts = canvas.map(0.3);
   canvas.drawGridLines(layout, &starts, cv::Scalar(230, 190, 120));
   for (size_t d = 0; d < layout.doors.size() && d < doors.size(); ++d) {
@@ -192,11 +196,12 @@ cv::Mat3b startCellsImage(const DebugCanvas& canvas, const OccupancyGrid& map, c
 
 }  // namespace
 
-void writeLayoutDebugImages(const std::string& dir, const OccupancyGrid& map, const std::vector<MapDoor>& closed_doors,
-                            const cv::Mat1b& grey, const cv::Mat1b& edges, const Layout& layout) {
+void writeLayoutDebugImages(const std::string& dir, const common::OccupancyGrid& map,
+                            const std::vector<common::MapDoor>& closed_doors, const cv::Mat1b& grey,
+                            const cv::Mat1b& edges, const Layout& layout) {
   std::error_code error;
   std::filesystem::create_directories(dir, error);
-  if (!std::filesystem::is_directory(dir)) throw InputError(dir, "cannot create debug folder");
+  if (!std::filesystem::is_directory(dir)) throw common::InputError(dir, "cannot create debug folder");
 
   const DebugCanvas canvas(layout, grey);
   writeImage(dir, "edges.png", edges);
@@ -209,4 +214,4 @@ void writeLayoutDebugImages(const std::string& dir, const OccupancyGrid& map, co
   writeImage(dir, "start_cells.png", startCellsImage(canvas, map, closed_doors, layout));
 }
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::prediction

@@ -12,14 +12,14 @@
 #include "hidden_rooms/common/input_error.h"
 #include "hidden_rooms/common/label_image.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::prediction {
 
-cv::Rect knownBoundingBox(const OccupancyGrid& map) {
-  return cv::boundingRect(map.cells != OccupancyGrid::kUnknown);
+cv::Rect knownBoundingBox(const common::OccupancyGrid& map) {
+  return cv::boundingRect(map.cells != common::OccupancyGrid::kUnknown);
 }
 
-bool nearestUnknownCell(const OccupancyGrid& map, const Point2& position, double max_distance, cv::Point* cell,
-                        std::string* problem) {
+bool nearestUnknownCell(const common::OccupancyGrid& map, const common::Point2& position, double max_distance,
+                        cv::Point* cell, std::string* problem) {
   int col = 0, row = 0;
   if (!map.cellOf(position, &col, &row)) {
     *problem = "door position (" + std::to_string(position.x()) + ", " + std::to_string(position.y()) +
@@ -30,7 +30,7 @@ bool nearestUnknownCell(const OccupancyGrid& map, const Point2& position, double
   double best = std::numeric_limits<double>::infinity();
   for (int r = std::max(0, row - radius); r <= std::min(map.height() - 1, row + radius); ++r)
     for (int c = std::max(0, col - radius); c <= std::min(map.width() - 1, col + radius); ++c) {
-      if (map.cells(r, c) != OccupancyGrid::kUnknown) continue;
+      if (map.cells(r, c) != common::OccupancyGrid::kUnknown) continue;
       const double distance = (map.cellCentre(c, r) - position).norm();
       if (distance < best && distance <= max_distance) {
         best = distance;
@@ -44,7 +44,8 @@ bool nearestUnknownCell(const OccupancyGrid& map, const Point2& position, double
   return true;
 }
 
-void finishPrediction(const OccupancyGrid& map, RoomPrediction* room, const std::optional<cv::Rect>& cells_within) {
+void finishPrediction(const common::OccupancyGrid& map, RoomPrediction* room,
+                      const std::optional<cv::Rect>& cells_within) {
   // The room's bounding box and one more pixel around it (where it is inside the image): all the work below.
   cv::Rect box;
   if (!room->mask.empty()) {
@@ -74,7 +75,7 @@ void finishPrediction(const OccupancyGrid& map, RoomPrediction* room, const std:
   for (const cv::Point& p : *largest) room->polygon.push_back(map.cellCentre(p.x, p.y));
 }
 
-RoomPrediction unplacedRoom(const OccupancyGrid& map, int door_id, const std::string& problem) {
+RoomPrediction unplacedRoom(const common::OccupancyGrid& map, int door_id, const std::string& problem) {
   RoomPrediction room;
   room.door_id = door_id;
   room.mask = cv::Mat1b::zeros(map.cells.size());
@@ -83,20 +84,21 @@ RoomPrediction unplacedRoom(const OccupancyGrid& map, int door_id, const std::st
   return room;
 }
 
-void checkUsableMap(const OccupancyGrid& map) {
-  if (map.empty()) throw InputError("map", "the map is empty");
-  if (cv::countNonZero(map.cells != OccupancyGrid::kUnknown) == 0)
-    throw InputError("map", "the map has no known cell");
-  if (cv::countNonZero(map.cells == OccupancyGrid::kFree) == 0)
-    throw InputError("map", "the map has no free cell (nothing was explored)");
+void checkUsableMap(const common::OccupancyGrid& map) {
+  if (map.empty()) throw common::InputError("map", "the map is empty");
+  if (cv::countNonZero(map.cells != common::OccupancyGrid::kUnknown) == 0)
+    throw common::InputError("map", "the map has no known cell");
+  if (cv::countNonZero(map.cells == common::OccupancyGrid::kFree) == 0)
+    throw common::InputError("map", "the map has no free cell (nothing was explored)");
   if (!(map.resolution > 0.0) || !std::isfinite(map.resolution))
-    throw InputError("map", "resolution must be positive");
+    throw common::InputError("map", "resolution must be positive");
 }
 
-void checkDoorsInsideMap(const OccupancyGrid& map, const DoorsFile& doors) {
+void checkDoorsInsideMap(const common::OccupancyGrid& map, const common::DoorsFile& doors) {
   std::set<int> ids;
-  for (const MapDoor& door : doors.doors) {
-    if (!ids.insert(door.id).second) throw InputError("doors", "door id " + std::to_string(door.id) + " is used twice");
+  for (const common::MapDoor& door : doors.doors) {
+    if (!ids.insert(door.id).second)
+      throw common::InputError("doors", "door id " + std::to_string(door.id) + " is used twice");
     int col = 0, row = 0;
     if (!map.cellOf(door.position, &col, &row)) {
       std::ostringstream problem;
@@ -104,29 +106,32 @@ void checkDoorsInsideMap(const OccupancyGrid& map, const DoorsFile& doors) {
               << door.position.y() << ") is outside the map (x " << map.origin.x() << " .. "
               << map.origin.x() + map.width() * map.resolution << ", y " << map.origin.y() << " .. "
               << map.origin.y() + map.height() * map.resolution << " m)";
-      throw InputError("door " + std::to_string(door.id), problem.str());
+      throw common::InputError("door " + std::to_string(door.id), problem.str());
     }
   }
 }
 
-OccupancyGrid insertRooms(const OccupancyGrid& map, const DoorsFile& doors, const std::vector<RoomPrediction>& rooms) {
-  OccupancyGrid completed = map;
+common::OccupancyGrid insertRooms(const common::OccupancyGrid& map, const common::DoorsFile& doors,
+                                  const std::vector<RoomPrediction>& rooms) {
+  common::OccupancyGrid completed = map;
   cv::Mat1b all_rooms = cv::Mat1b::zeros(map.cells.size());
   for (const RoomPrediction& room : rooms)
     if (room.placed) all_rooms |= room.mask;
-  completed.cells.setTo(OccupancyGrid::kFree, all_rooms);
+  completed.cells.setTo(common::OccupancyGrid::kFree, all_rooms);
   // Walls: unknown cells touching a room.
   cv::Mat1b around;
   cv::dilate(all_rooms, around, cv::Mat1b::ones(3, 3));
-  completed.cells.setTo(OccupancyGrid::kOccupied, around & ~all_rooms & (map.cells == OccupancyGrid::kUnknown));
+  completed.cells.setTo(common::OccupancyGrid::kOccupied,
+                        around & ~all_rooms & (map.cells == common::OccupancyGrid::kUnknown));
 
   // Doors: a free rectangle of the door's width across the door line, from the explored side to the room.
   const double max_depth = 1.0;  // metres on each side of the door line
   for (size_t k = 0; k < rooms.size() && k < doors.doors.size(); ++k) {
     if (!rooms[k].placed) continue;
-    const MapDoor& door = doors.doors[k];
-    const Point2 along = door.orientation == DoorOrientation::kAlongX ? Point2(1, 0) : Point2(0, 1);
-    const Point2 across(-along.y(), along.x());
+    const common::MapDoor& door = doors.doors[k];
+    const common::Point2 along =
+        door.orientation == common::DoorOrientation::kAlongX ? common::Point2(1, 0) : common::Point2(0, 1);
+    const common::Point2 across(-along.y(), along.x());
     const int half_width = static_cast<int>(std::floor(0.5 * door.width / map.resolution));
     const int depth = static_cast<int>(std::ceil(max_depth / map.resolution));
     for (int s = -half_width; s <= half_width; ++s) {
@@ -136,23 +141,25 @@ OccupancyGrid insertRooms(const OccupancyGrid& map, const DoorsFile& doors, cons
         bool reached = false;
         for (int t = 0; t <= depth && !reached; ++t) {
           int col = 0, row = 0;
-          const Point2 p = door.position + map.resolution * (s * along + side * t * across);
+          const common::Point2 p = door.position + map.resolution * (s * along + side * t * across);
           if (!completed.cellOf(p, &col, &row)) break;
-          if (t > 0 && completed.cells(row, col) == OccupancyGrid::kFree && map.cells(row, col) != OccupancyGrid::kOccupied) {
+          if (t > 0 && completed.cells(row, col) == common::OccupancyGrid::kFree &&
+              map.cells(row, col) != common::OccupancyGrid::kOccupied) {
             reached = true;
             break;
           }
           path.emplace_back(col, row);
         }
         if (!reached) continue;
-        for (const cv::Point& cell : path) completed.cells(cell) = OccupancyGrid::kFree;
+        for (const cv::Point& cell : path) completed.cells(cell) = common::OccupancyGrid::kFree;
       }
     }
   }
   return completed;
 }
 
-cv::Mat1w roomLabels(const OccupancyGrid& map, const DoorsFile& doors, const std::vector<RoomPrediction>& rooms) {
+cv::Mat1w roomLabels(const common::OccupancyGrid& map, const common::DoorsFile& doors,
+                     const std::vector<RoomPrediction>& rooms) {
   cv::Mat1w labels = cv::Mat1w::zeros(map.cells.size());
   const auto door_distance = [&](const cv::Point& cell, size_t k) {
     return static_cast<float>((map.cellCentre(cell.x, cell.y) - doors.doors[k].position).norm());
@@ -175,8 +182,7 @@ cv::Mat1w roomLabels(const OccupancyGrid& map, const DoorsFile& doors, const std
   return labels;
 }
 
-
-cv::Mat3b renderPredictionOverlay(const OccupancyGrid& map, const cv::Mat1w& predicted_labels,
+cv::Mat3b renderPredictionOverlay(const common::OccupancyGrid& map, const cv::Mat1w& predicted_labels,
                                   const cv::Mat& true_labels) {
   cv::Mat3b overlay;
   cv::cvtColor(map.toGreyImage(), overlay, cv::COLOR_GRAY2BGR);
@@ -184,7 +190,7 @@ cv::Mat3b renderPredictionOverlay(const OccupancyGrid& map, const cv::Mat1w& pre
   double max_label = 0.0;
   cv::minMaxLoc(predicted_labels, nullptr, &max_label);
   std::vector<cv::Vec3b> colours(static_cast<size_t>(max_label) + 1);
-  for (size_t label = 1; label < colours.size(); ++label) colours[label] = roomColour(static_cast<int>(label));
+  for (size_t label = 1; label < colours.size(); ++label) colours[label] = common::roomColour(static_cast<int>(label));
   for (int row = 0; row < overlay.rows; ++row) {
     const uint16_t* label = predicted_labels.ptr<uint16_t>(row);
     cv::Vec3b* pixel = overlay.ptr<cv::Vec3b>(row);
@@ -219,4 +225,4 @@ cv::Mat3b renderPredictionOverlay(const OccupancyGrid& map, const cv::Mat1w& pre
   return overlay;
 }
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::prediction

@@ -13,7 +13,7 @@
 #include "hidden_rooms/prediction/structured_predictor.h"
 #include "hidden_rooms/prediction/thesis_predictor.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::prediction {
 
 namespace {
 
@@ -44,20 +44,20 @@ const std::set<std::string>& namesReadByAnyMethod() {
 }  // namespace
 
 std::map<std::string, double> loadParameterFile(const std::string& path) {
-  const YAML::Node root = loadYamlFile(path, "parameters file");
+  const YAML::Node root = common::loadYamlFile(path, "parameters file");
   std::map<std::string, double> parameters;
   if (root.IsNull()) return parameters;
-  if (!root.IsMap()) throw InputError(path, "parameters file must be a mapping of names to numbers");
+  if (!root.IsMap()) throw common::InputError(path, "parameters file must be a mapping of names to numbers");
   for (const auto& entry : root) {
-    if (!entry.first.IsScalar()) throw InputError(path, "a parameter name is not a plain name");
+    if (!entry.first.IsScalar()) throw common::InputError(path, "a parameter name is not a plain name");
     const std::string name = entry.first.Scalar();
     double value = 0.0;
     try {
       value = entry.second.as<double>();
     } catch (const YAML::Exception&) {
-      throw InputError(path, "parameter '" + name + "' is not a number");
+      throw common::InputError(path, "parameter '" + name + "' is not a number");
     }
-    if (!std::isfinite(value)) throw InputError(path, "parameter '" + name + "' is not finite");
+    if (!std::isfinite(value)) throw common::InputError(path, "parameter '" + name + "' is not finite");
     parameters[name] = value;
   }
   return parameters;
@@ -67,13 +67,13 @@ std::map<std::string, double> resolveParameters(const RoomPredictor& method,
                                                 const std::map<std::string, double>& overrides) {
   std::map<std::string, double> parameters = method.defaultParameters();
   for (const auto& [name, value] : overrides) {
-    if (!std::isfinite(value)) throw InputError("parameters", "parameter '" + name + "' is not finite");
+    if (!std::isfinite(value)) throw common::InputError("parameters", "parameter '" + name + "' is not finite");
     if (parameters.count(name)) {
       parameters[name] = value;
       continue;
     }
     if (namesReadByAnyMethod().count(name) == 0)
-      throw InputError("parameters", "unknown parameter '" + name + "' (no prediction method reads it)");
+      throw common::InputError("parameters", "unknown parameter '" + name + "' (no prediction method reads it)");
   }
   return parameters;
 }
@@ -89,9 +89,9 @@ std::unique_ptr<RoomPredictor> makeRoomPredictor(const std::string& name) {
   if (found == registry().end()) {
     std::string known;
     for (const std::string& method : roomPredictorNames()) known += (known.empty() ? "" : ", ") + method;
-    throw InputError("method", "unknown prediction method '" + name + "' (known: " + known + ")");
+    throw common::InputError("method", "unknown prediction method '" + name + "' (known: " + known + ")");
   }
   return found->second();
 }
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::prediction

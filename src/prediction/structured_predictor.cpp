@@ -4,7 +4,7 @@
 
 #include "hidden_rooms/prediction/prediction_support.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::prediction {
 
 std::map<std::string, double> StructuredPredictor::defaultParameters() const {
   return layoutParameters(LayoutOptions());
@@ -29,12 +29,12 @@ std::vector<int> structuredRoomCells(const Layout& layout, const DoorStart& star
   return room;
 }
 
-RoomPrediction roomFromCells(const OccupancyGrid& map, const Layout& layout, int door_id,
+RoomPrediction roomFromCells(const common::OccupancyGrid& map, const Layout& layout, int door_id,
                              const std::vector<int>& cells) {
   RoomPrediction room;
   room.door_id = door_id;
   room.mask = cellsMask(layout, cells);
-  room.mask.setTo(0, map.cells != OccupancyGrid::kUnknown);
+  room.mask.setTo(0, map.cells != common::OccupancyGrid::kUnknown);
   finishPrediction(map, &room);
   return room;
 }
@@ -62,4 +62,4 @@ PredictionResult StructuredPredictor::predict(const PredictionRequest& request) 
   return result;
 }
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::prediction

@@ -7,7 +7,7 @@
 
 #include <opencv2/imgproc.hpp>
 
-namespace hidden_rooms {
+namespace hidden_rooms::prediction {
 
 namespace {
 
@@ -322,12 +322,12 @@ void ThesisExpansion::capCandidates(ThesisRoom* room, Candidates* candidates) co
   room->capped = true;
   cv::Rect box = grid_.cells[room->cells.front()].rect;
   for (int c : room->cells) box |= grid_.cells[c].rect;
-  const Point2 centre(box.x + 0.5 * box.width, box.y + 0.5 * box.height);
+  const common::Point2 centre(box.x + 0.5 * box.width, box.y + 0.5 * box.height);
   std::vector<size_t> order(cells.size());
   std::iota(order.begin(), order.end(), 0);
   auto distance = [&](size_t k) {
     const cv::Rect& rect = grid_.cells[cells[k]].rect;
-    return (Point2(rect.x + 0.5 * rect.width, rect.y + 0.5 * rect.height) - centre).norm();
+    return (common::Point2(rect.x + 0.5 * rect.width, rect.y + 0.5 * rect.height) - centre).norm();
   };
   std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
     if (edge_adjacent[a] != edge_adjacent[b]) return edge_adjacent[a] > edge_adjacent[b];
@@ -607,4 +607,4 @@ void ThesisExpansion::fixPair(int a, int b) {
   }
 }
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::prediction

@@ -15,11 +15,11 @@
 #include "hidden_rooms/prediction/structured_predictor.h"
 #include "hidden_rooms/prediction/thesis_expansion.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::prediction {
 
 namespace {
 
-using ParameterField = hidden_rooms::ParameterField<ThesisOptions>;
+using ParameterField = hidden_rooms::common::ParameterField<ThesisOptions>;
 
 const std::vector<ParameterField>& parameterFields() {
   static const std::vector<ParameterField> fields{
@@ -48,16 +48,17 @@ const std::vector<ParameterField>& parameterFields() {
 }
 
 void validate(const ThesisOptions& o) {
-  requireFiniteParameters(parameterFields(), o);
-  requireParameterInRange("thesis_depth", o.depth, {0, 1000, false, false, true});
-  requireParameterInRange("thesis_max_candidates", o.max_candidates, {0, 20, false, false, true});
-  requireParameterInRange("thesis_max_exchangeable", o.max_exchangeable, {0, 20, false, false, true});
-  requireParameterInRange("thesis_fix_pairs", o.fix_pairs, {0, 1, false, false, true});
-  requireParameterInRange("thesis_border_rooms", o.border_rooms, {0, 1, false, false, true});
-  requireParameterInRange("thesis_border_cells_free", o.border_cells_free, {0, 1, false, false, true});
-  requireParameterInRange("thesis_outcast_min_neighbours", o.outcast_min_neighbours, {1, 4, false, false, true});
+  common::requireFiniteParameters(parameterFields(), o);
+  common::requireParameterInRange("thesis_depth", o.depth, {0, 1000, false, false, true});
+  common::requireParameterInRange("thesis_max_candidates", o.max_candidates, {0, 20, false, false, true});
+  common::requireParameterInRange("thesis_max_exchangeable", o.max_exchangeable, {0, 20, false, false, true});
+  common::requireParameterInRange("thesis_fix_pairs", o.fix_pairs, {0, 1, false, false, true});
+  common::requireParameterInRange("thesis_border_rooms", o.border_rooms, {0, 1, false, false, true});
+  common::requireParameterInRange("thesis_border_cells_free", o.border_cells_free, {0, 1, false, false, true});
+  common::requireParameterInRange("thesis_outcast_min_neighbours", o.outcast_min_neighbours,
+                                  {1, 4, false, false, true});
   if (o.proportion_threshold < 1.0)
-    throw InputError("parameters", "parameter 'thesis_proportion_threshold' must be at least 1");
+    throw common::InputError("parameters", "parameter 'thesis_proportion_threshold' must be at least 1");
 }
 
 enum class Growth { kUp, kDown, kLeft, kRight };
@@ -122,14 +123,14 @@ cv::Rect squareRect(const BorderSide& side, int depth) {
 }
 
 // The border room's pixels: the square's unknown pixels outside the other rooms, connected to the door's wall.
-cv::Mat1b borderRoomMask(const OccupancyGrid& map, const cv::Rect& square, const BorderSide& side,
+cv::Mat1b borderRoomMask(const common::OccupancyGrid& map, const cv::Rect& square, const BorderSide& side,
                          const cv::Mat1b& other_rooms) {
   cv::Mat1b mask = cv::Mat1b::zeros(map.cells.size());
   const cv::Rect clipped = square & cv::Rect(cv::Point(0, 0), map.cells.size());
   if (clipped.empty()) return mask;
   cv::Mat1b part = mask(clipped);
   part.setTo(255);
-  part.setTo(0, map.cells(clipped) != OccupancyGrid::kUnknown);
+  part.setTo(0, map.cells(clipped) != common::OccupancyGrid::kUnknown);
   part.setTo(0, other_rooms(clipped));
   cv::Mat1i labels;
   const int count = cv::connectedComponents(part, labels, 4, CV_32S);
@@ -153,17 +154,17 @@ cv::Mat1b borderRoomMask(const OccupancyGrid& map, const cv::Rect& square, const
 // ---------------------------------------------------------------------------------------------------------
 
 const std::vector<std::string>& thesisParameterNames() {
-  static const std::vector<std::string> names = parameterNames(parameterFields());
+  static const std::vector<std::string> names = common::parameterNames(parameterFields());
   return names;
 }
 
 std::map<std::string, double> thesisParameters(const ThesisOptions& options) {
-  return parameterValues(parameterFields(), options);
+  return common::parameterValues(parameterFields(), options);
 }
 
 ThesisOptions thesisOptionsFromParameters(const std::map<std::string, double>& parameters) {
   ThesisOptions options;
-  applyParameterValues(parameterFields(), parameters, &options);
+  common::applyParameterValues(parameterFields(), parameters, &options);
   validate(options);
   return options;
 }
@@ -319,10 +320,10 @@ PredictionResult ThesisPredictor::predict(const PredictionRequest& request) cons
     for (int y : grid.ys)
       if (y >= 0 && y < overlay.rows) cv::line(overlay, {0, y}, {overlay.cols - 1, y}, cv::Scalar(230, 200, 150), 1);
     const std::string path = request.debug_dir + "/thesis_rooms.png";
-    writeImage(path, overlay);
+    common::writeImage(path, overlay);
   }
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
   return result;
 }
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::prediction

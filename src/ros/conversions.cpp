@@ -25,7 +25,7 @@ double floatToDouble(float value) {
 
 }  // namespace
 
-geometry_msgs::Point toRos(const Point2& point, double z) {
+geometry_msgs::Point toRos(const common::Point2& point, double z) {
   geometry_msgs::Point message;
   message.x = point.x();
   message.y = point.y();
@@ -33,7 +33,7 @@ geometry_msgs::Point toRos(const Point2& point, double z) {
   return message;
 }
 
-nav_msgs::OccupancyGrid toRos(const OccupancyGrid& grid, const std::string& frame_id, const ros::Time& stamp) {
+nav_msgs::OccupancyGrid toRos(const common::OccupancyGrid& grid, const std::string& frame_id, const ros::Time& stamp) {
   nav_msgs::OccupancyGrid message;
   message.header.frame_id = frame_id;
   message.header.stamp = stamp;
@@ -52,19 +52,20 @@ nav_msgs::OccupancyGrid toRos(const OccupancyGrid& grid, const std::string& fram
   return message;
 }
 
-OccupancyGrid fromRos(const nav_msgs::OccupancyGrid& message) {
+common::OccupancyGrid fromRos(const nav_msgs::OccupancyGrid& message) {
   const auto& info = message.info;
   if (static_cast<size_t>(info.width) * info.height != message.data.size())
-    throw InputError("map message", "data has " + std::to_string(message.data.size()) + " cells, width x height is " +
-                                        std::to_string(static_cast<size_t>(info.width) * info.height));
+    throw common::InputError("map message", "data has " + std::to_string(message.data.size()) +
+                                                " cells, width x height is " +
+                                                std::to_string(static_cast<size_t>(info.width) * info.height));
   if (!(info.resolution > 0.0f) || !std::isfinite(info.resolution))
-    throw InputError("map message", "resolution must be positive");
+    throw common::InputError("map message", "resolution must be positive");
   const auto& q = info.origin.orientation;
   const double yaw = std::atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z));
-  if (std::abs(yaw) > 1e-6) throw InputError("map message", "rotated map origins are not supported");
-  OccupancyGrid grid;
+  if (std::abs(yaw) > 1e-6) throw common::InputError("map message", "rotated map origins are not supported");
+  common::OccupancyGrid grid;
   grid.resolution = floatToDouble(info.resolution);
-  grid.origin = Point2(info.origin.position.x, info.origin.position.y);
+  grid.origin = common::Point2(info.origin.position.x, info.origin.position.y);
   grid.cells.create(static_cast<int>(info.height), static_cast<int>(info.width));
   for (int row = 0; row < grid.height(); ++row) {
     const auto begin = message.data.begin() + static_cast<size_t>(grid.height() - 1 - row) * grid.width();
@@ -73,53 +74,53 @@ OccupancyGrid fromRos(const nav_msgs::OccupancyGrid& message) {
   return grid;
 }
 
-hidden_rooms::ClosedDoor toRos(const MapDoor& door) {
+hidden_rooms::ClosedDoor toRos(const common::MapDoor& door) {
   hidden_rooms::ClosedDoor message;
   message.id = door.id;
   message.position.x = door.position.x();
   message.position.y = door.position.y();
   message.width = door.width;
-  message.orientation = door.orientation == DoorOrientation::kAlongX ? hidden_rooms::ClosedDoor::ALONG_X
-                                                                      : hidden_rooms::ClosedDoor::ALONG_Y;
+  message.orientation = door.orientation == common::DoorOrientation::kAlongX ? hidden_rooms::ClosedDoor::ALONG_X
+                                                                             : hidden_rooms::ClosedDoor::ALONG_Y;
   return message;
 }
 
-MapDoor fromRos(const hidden_rooms::ClosedDoor& message) {
+common::MapDoor fromRos(const hidden_rooms::ClosedDoor& message) {
   if (!std::isfinite(message.position.x) || !std::isfinite(message.position.y) || !std::isfinite(message.width) ||
       message.width <= 0.0)
-    throw InputError("door " + std::to_string(message.id), "position and width must be finite, width positive");
+    throw common::InputError("door " + std::to_string(message.id), "position and width must be finite, width positive");
   if (message.orientation != hidden_rooms::ClosedDoor::ALONG_X && message.orientation != hidden_rooms::ClosedDoor::ALONG_Y)
-    throw InputError("door " + std::to_string(message.id), "orientation must be ALONG_X (0) or ALONG_Y (1)");
-  MapDoor door;
+    throw common::InputError("door " + std::to_string(message.id), "orientation must be ALONG_X (0) or ALONG_Y (1)");
+  common::MapDoor door;
   door.id = message.id;
-  door.position = Point2(message.position.x, message.position.y);
+  door.position = common::Point2(message.position.x, message.position.y);
   door.width = message.width;
-  door.orientation = message.orientation == hidden_rooms::ClosedDoor::ALONG_X ? DoorOrientation::kAlongX
-                                                                               : DoorOrientation::kAlongY;
+  door.orientation = message.orientation == hidden_rooms::ClosedDoor::ALONG_X ? common::DoorOrientation::kAlongX
+                                                                              : common::DoorOrientation::kAlongY;
   return door;
 }
 
-DoorsFile fromRos(const std::vector<hidden_rooms::ClosedDoor>& messages, const std::string& frame) {
-  DoorsFile doors;
+common::DoorsFile fromRos(const std::vector<hidden_rooms::ClosedDoor>& messages, const std::string& frame) {
+  common::DoorsFile doors;
   doors.frame = frame;
   for (const hidden_rooms::ClosedDoor& message : messages) doors.doors.push_back(fromRos(message));
   return doors;
 }
 
-std::vector<hidden_rooms::ClosedDoor> toRos(const DoorsFile& doors) {
+std::vector<hidden_rooms::ClosedDoor> toRos(const common::DoorsFile& doors) {
   std::vector<hidden_rooms::ClosedDoor> messages;
-  for (const MapDoor& door : doors.doors) messages.push_back(toRos(door));
+  for (const common::MapDoor& door : doors.doors) messages.push_back(toRos(door));
   return messages;
 }
 
 std::map<std::string, double> fromRos(const std::vector<hidden_rooms::PredictionParameter>& messages) {
   std::map<std::string, double> parameters;
   for (const hidden_rooms::PredictionParameter& message : messages) {
-    if (message.name.empty()) throw InputError("parameters", "a parameter has no name");
+    if (message.name.empty()) throw common::InputError("parameters", "a parameter has no name");
     if (!std::isfinite(message.value))
-      throw InputError("parameters", "parameter '" + message.name + "' is not finite");
+      throw common::InputError("parameters", "parameter '" + message.name + "' is not finite");
     if (!parameters.emplace(message.name, message.value).second)
-      throw InputError("parameters", "parameter '" + message.name + "' is given twice");
+      throw common::InputError("parameters", "parameter '" + message.name + "' is given twice");
   }
   return parameters;
 }
@@ -135,14 +136,14 @@ std::vector<hidden_rooms::PredictionParameter> toRos(const std::map<std::string,
   return messages;
 }
 
-hidden_rooms::PredictedRoom toRos(const RoomPrediction& room, int label, const OccupancyGrid& map,
+hidden_rooms::PredictedRoom toRos(const prediction::RoomPrediction& room, int label, const common::OccupancyGrid& map,
                                   const std::string& frame_id, const ros::Time& stamp) {
   hidden_rooms::PredictedRoom message;
   message.door_id = room.door_id;
   message.label = static_cast<uint32_t>(label);
   message.status = room.placed ? hidden_rooms::PredictedRoom::PREDICTED : hidden_rooms::PredictedRoom::NOT_PLACED;
   message.problem = room.placed ? "" : room.problem;
-  for (const Point2& p : room.polygon) message.polygon.push_back(toRos(p, 0.0));
+  for (const common::Point2& p : room.polygon) message.polygon.push_back(toRos(p, 0.0));
   message.area = room.area;
   const auto score = room.terms.find("score");
   message.score = score != room.terms.end() ? score->second : std::numeric_limits<double>::quiet_NaN();
@@ -158,19 +159,19 @@ hidden_rooms::PredictedRoom toRos(const RoomPrediction& room, int label, const O
   if (room.placed && !room.mask.empty()) cv::findNonZero(room.mask, cells);
   if (!cells.empty()) {
     const cv::Rect box = cv::boundingRect(cells);
-    OccupancyGrid crop;
+    common::OccupancyGrid crop;
     crop.resolution = map.resolution;
-    crop.origin = map.origin + map.resolution * Point2(box.x, map.height() - box.y - box.height);
-    crop.cells = cv::Mat_<int8_t>(box.size(), OccupancyGrid::kUnknown);
-    crop.cells.setTo(OccupancyGrid::kFree, room.mask(box));
+    crop.origin = map.origin + map.resolution * common::Point2(box.x, map.height() - box.y - box.height);
+    crop.cells = cv::Mat_<int8_t>(box.size(), common::OccupancyGrid::kUnknown);
+    crop.cells.setTo(common::OccupancyGrid::kFree, room.mask(box));
     message.mask = toRos(crop, frame_id, stamp);
   }
   return message;
 }
 
-RoomPrediction fromRos(const hidden_rooms::PredictedRoom& message, const OccupancyGrid& map) {
+prediction::RoomPrediction fromRos(const hidden_rooms::PredictedRoom& message, const common::OccupancyGrid& map) {
   const std::string source = "room of door " + std::to_string(message.door_id);
-  RoomPrediction room;
+  prediction::RoomPrediction room;
   room.door_id = message.door_id;
   room.placed = message.status == hidden_rooms::PredictedRoom::PREDICTED;
   room.problem = message.problem;
@@ -178,33 +179,33 @@ RoomPrediction fromRos(const hidden_rooms::PredictedRoom& message, const Occupan
   room.area = message.area;
   for (const geometry_msgs::Point& p : message.polygon) room.polygon.emplace_back(p.x, p.y);
   if (message.term_names.size() != message.term_values.size())
-    throw InputError(source, "term_names and term_values differ in length");
+    throw common::InputError(source, "term_names and term_values differ in length");
   for (size_t k = 0; k < message.term_names.size(); ++k) room.terms[message.term_names[k]] = message.term_values[k];
   if (!room.placed || message.mask.info.width == 0 || message.mask.info.height == 0) return room;
-  const OccupancyGrid crop = fromRos(message.mask);
-  const Point2 offset = (crop.origin - map.origin) / map.resolution;
+  const common::OccupancyGrid crop = fromRos(message.mask);
+  const common::Point2 offset = (crop.origin - map.origin) / map.resolution;
   const int col = static_cast<int>(std::lround(offset.x()));
   const int row = map.height() - static_cast<int>(std::lround(offset.y())) - crop.height();
   if (std::abs(crop.resolution - map.resolution) > 1e-9 * map.resolution ||
-      (offset - Point2(std::round(offset.x()), std::round(offset.y()))).cwiseAbs().maxCoeff() > 1e-3)
-    throw InputError(source, "mask is not on the map's cell grid");
+      (offset - common::Point2(std::round(offset.x()), std::round(offset.y()))).cwiseAbs().maxCoeff() > 1e-3)
+    throw common::InputError(source, "mask is not on the map's cell grid");
   if (col < 0 || row < 0 || col + crop.width() > map.width() || row + crop.height() > map.height())
-    throw InputError(source, "mask reaches outside the map");
-  room.mask(cv::Rect(col, row, crop.width(), crop.height())).setTo(255, crop.cells == OccupancyGrid::kFree);
+    throw common::InputError(source, "mask reaches outside the map");
+  room.mask(cv::Rect(col, row, crop.width(), crop.height())).setTo(255, crop.cells == common::OccupancyGrid::kFree);
   return room;
 }
 
-VelocityCommand fromRos(const geometry_msgs::Twist& message) { return {message.linear.x, message.angular.z}; }
+common::VelocityCommand fromRos(const geometry_msgs::Twist& message) { return {message.linear.x, message.angular.z}; }
 
-geometry_msgs::Twist toRos(const VelocityCommand& command) {
+geometry_msgs::Twist toRos(const common::VelocityCommand& command) {
   geometry_msgs::Twist message;
   message.linear.x = command.linear;
   message.angular.z = command.angular;
   return message;
 }
 
-LaserGeometry laserGeometryOf(const sensor_msgs::LaserScan& message) {
-  LaserGeometry laser;
+common::LaserGeometry laserGeometryOf(const sensor_msgs::LaserScan& message) {
+  common::LaserGeometry laser;
   laser.beams = static_cast<int>(message.ranges.size());
   laser.angle_min = message.angle_min;
   laser.angle_increment = message.angle_increment;
@@ -212,7 +213,7 @@ LaserGeometry laserGeometryOf(const sensor_msgs::LaserScan& message) {
   return laser;
 }
 
-sensor_msgs::LaserScan toRos(const std::vector<float>& ranges, const LaserGeometry& laser, double min_range,
+sensor_msgs::LaserScan toRos(const std::vector<float>& ranges, const common::LaserGeometry& laser, double min_range,
                              double scan_time, const std::string& frame_id, const ros::Time& stamp) {
   sensor_msgs::LaserScan message;
   message.header.frame_id = frame_id;
@@ -228,8 +229,8 @@ sensor_msgs::LaserScan toRos(const std::vector<float>& ranges, const LaserGeomet
   return message;
 }
 
-nav_msgs::Odometry toRos(const Pose2& pose, const VelocityCommand& velocity, const std::string& frame_id,
-                         const std::string& child_frame_id, const ros::Time& stamp) {
+nav_msgs::Odometry toRos(const common::Pose2& pose, const common::VelocityCommand& velocity,
+                         const std::string& frame_id, const std::string& child_frame_id, const ros::Time& stamp) {
   nav_msgs::Odometry message;
   message.header.frame_id = frame_id;
   message.header.stamp = stamp;
@@ -243,7 +244,7 @@ nav_msgs::Odometry toRos(const Pose2& pose, const VelocityCommand& velocity, con
   return message;
 }
 
-geometry_msgs::TransformStamped toTransform(const Pose2& pose, const std::string& frame_id,
+geometry_msgs::TransformStamped toTransform(const common::Pose2& pose, const std::string& frame_id,
                                             const std::string& child_frame_id, const ros::Time& stamp) {
   geometry_msgs::TransformStamped message;
   message.header.frame_id = frame_id;
@@ -256,17 +257,17 @@ geometry_msgs::TransformStamped toTransform(const Pose2& pose, const std::string
   return message;
 }
 
-Pose2 fromRos(const geometry_msgs::Pose& pose) {
+common::Pose2 fromRos(const geometry_msgs::Pose& pose) {
   const auto& q = pose.orientation;
   return {pose.position.x, pose.position.y,
           std::atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))};
 }
 
-RangeScan fromRos(const sensor_msgs::LaserScan& message, const Pose2& sensor_pose) {
-  if (message.ranges.empty()) throw InputError("scan", "has no beams");
+common::RangeScan fromRos(const sensor_msgs::LaserScan& message, const common::Pose2& sensor_pose) {
+  if (message.ranges.empty()) throw common::InputError("scan", "has no beams");
   if (!std::isfinite(message.angle_min) || !std::isfinite(message.angle_increment) || message.angle_increment == 0.0f)
-    throw InputError("scan", "non-finite or zero angle increment");
-  RangeScan scan;
+    throw common::InputError("scan", "non-finite or zero angle increment");
+  common::RangeScan scan;
   scan.angle_min = message.angle_min;
   scan.angle_increment = message.angle_increment;
   scan.range_min = message.range_min;
@@ -276,7 +277,7 @@ RangeScan fromRos(const sensor_msgs::LaserScan& message, const Pose2& sensor_pos
   return scan;
 }
 
-Pose2 fromRos(const geometry_msgs::Transform& transform) {
+common::Pose2 fromRos(const geometry_msgs::Transform& transform) {
   geometry_msgs::Pose pose;
   pose.position.x = transform.translation.x;
   pose.position.y = transform.translation.y;
@@ -284,12 +285,12 @@ Pose2 fromRos(const geometry_msgs::Transform& transform) {
   return fromRos(pose);
 }
 
-geometry_msgs::PoseArray toRos(const std::vector<RbpfParticle>& particles, const std::string& frame_id,
+geometry_msgs::PoseArray toRos(const std::vector<mapping::RbpfParticle>& particles, const std::string& frame_id,
                                const ros::Time& stamp) {
   geometry_msgs::PoseArray message;
   message.header.frame_id = frame_id;
   message.header.stamp = stamp;
-  for (const RbpfParticle& particle : particles) {
+  for (const mapping::RbpfParticle& particle : particles) {
     geometry_msgs::Pose pose;
     pose.position.x = particle.pose.x;
     pose.position.y = particle.pose.y;

@@ -15,7 +15,7 @@ namespace hidden_rooms {
 
 ExplorerOptions readExplorerOptions(const ros::NodeHandle& nh) {
   ExplorerOptions options;
-  GridPlannerOptions& planner = options.planner;
+  exploration::GridPlannerOptions& planner = options.planner;
   nh.param("free_threshold", planner.free_threshold, planner.free_threshold);
   nh.param("occupied_threshold", planner.occupied_threshold, planner.occupied_threshold);
   nh.param("robot_radius", planner.robot_radius, planner.robot_radius);
@@ -27,21 +27,21 @@ ExplorerOptions readExplorerOptions(const ros::NodeHandle& nh) {
   nh.param("smoothing_window", planner.smoothing_window, planner.smoothing_window);
   validate(planner);
 
-  FrontierOptions& frontiers = options.frontiers;
+  exploration::FrontierOptions& frontiers = options.frontiers;
   frontiers.free_threshold = planner.free_threshold;
   frontiers.occupied_threshold = planner.occupied_threshold;
   nh.param("min_frontier_cells", frontiers.min_frontier_cells, frontiers.min_frontier_cells);
   nh.param("min_unknown_cells", frontiers.min_unknown_cells, frontiers.min_unknown_cells);
   nh.param("goal_reach", frontiers.goal_reach, frontiers.goal_reach);
   nh.param("min_goal_distance", frontiers.min_goal_distance, frontiers.min_goal_distance);
-  if (frontiers.min_frontier_cells < 1) throw InputError("~min_frontier_cells", "must be at least 1");
-  if (frontiers.min_unknown_cells < 1) throw InputError("~min_unknown_cells", "must be at least 1");
+  if (frontiers.min_frontier_cells < 1) throw common::InputError("~min_frontier_cells", "must be at least 1");
+  if (frontiers.min_unknown_cells < 1) throw common::InputError("~min_unknown_cells", "must be at least 1");
   if (!std::isfinite(frontiers.goal_reach) || frontiers.goal_reach < 0.0)
-    throw InputError("~goal_reach", "must be zero or positive");
+    throw common::InputError("~goal_reach", "must be zero or positive");
   if (!std::isfinite(frontiers.min_goal_distance) || frontiers.min_goal_distance < 0.0)
-    throw InputError("~min_goal_distance", "must be zero or positive");
+    throw common::InputError("~min_goal_distance", "must be zero or positive");
 
-  PathFollowerOptions& follower = options.follower;
+  exploration::PathFollowerOptions& follower = options.follower;
   nh.param("max_linear_velocity", follower.max_linear_velocity, follower.max_linear_velocity);
   nh.param("max_angular_velocity", follower.max_angular_velocity, follower.max_angular_velocity);
   nh.param("lookahead", follower.lookahead, follower.lookahead);
@@ -68,7 +68,7 @@ ExplorerOptions readExplorerOptions(const ros::NodeHandle& nh) {
   nh.param("max_recoveries", follower.max_recoveries, follower.max_recoveries);
   validate(follower);
 
-  BlockedPassagesOptions& passages = options.passages;
+  exploration::BlockedPassagesOptions& passages = options.passages;
   nh.param("blocked_passage_failures", passages.failures, passages.failures);
   nh.param("blocked_passage_length", passages.length, passages.length);
   nh.param("blocked_passage_radius", passages.radius, passages.radius);
@@ -87,20 +87,22 @@ ExplorerOptions readExplorerOptions(const ros::NodeHandle& nh) {
   nh.param("map_timeout", options.map_timeout, options.map_timeout);
   nh.param("obstacle_memory", options.obstacle_memory, options.obstacle_memory);
   if (options.map_frame.empty() || options.base_frame.empty())
-    throw InputError("~map_frame, ~base_frame", "must not be empty");
+    throw common::InputError("~map_frame, ~base_frame", "must not be empty");
   if (!std::isfinite(options.control_rate) || options.control_rate <= 0.0)
-    throw InputError("~control_rate", "must be positive");
+    throw common::InputError("~control_rate", "must be positive");
   for (const auto& [name, value] : {std::pair<const char*, double>{"replan_interval", options.replan_interval},
                                     {"goal_hysteresis", options.goal_hysteresis},
                                     {"blacklist_radius", options.blacklist_radius},
                                     {"map_timeout", options.map_timeout},
                                     {"obstacle_memory", options.obstacle_memory}})
-    if (!std::isfinite(value) || value < 0.0) throw InputError(std::string("~") + name, "must be zero or positive");
+    if (!std::isfinite(value) || value < 0.0)
+      throw common::InputError(std::string("~") + name, "must be zero or positive");
   for (const auto& [name, value] : {std::pair<const char*, double>{"scan_timeout", options.scan_timeout},
                                     {"pose_timeout", options.pose_timeout}})
-    if (!std::isfinite(value) || value <= 0.0) throw InputError(std::string("~") + name, "must be positive");
-  if (!std::isfinite(options.search_angular_velocity)) throw InputError("~search_angular_velocity", "must be finite");
-  if (options.done_confirmations < 1) throw InputError("~done_confirmations", "must be at least 1");
+    if (!std::isfinite(value) || value <= 0.0) throw common::InputError(std::string("~") + name, "must be positive");
+  if (!std::isfinite(options.search_angular_velocity))
+    throw common::InputError("~search_angular_velocity", "must be finite");
+  if (options.done_confirmations < 1) throw common::InputError("~done_confirmations", "must be at least 1");
   return options;
 }
 
@@ -125,13 +127,13 @@ void Explorer::onMap(const nav_msgs::OccupancyGrid::ConstPtr& map) {
   map_received_ = ros::Time::now();
   try {
     policy_.setMap(fromRos(*map));
-  } catch (const InputError& error) {
+  } catch (const common::InputError& error) {
     policy_.setUnusableMap(error.what());  // reported when the policy plans with it
   }
 }
 
 void Explorer::onScan(const sensor_msgs::LaserScan::ConstPtr& scan) {
-  Pose2 sensor;
+  common::Pose2 sensor;
   try {
     sensor = fromRos(tf_buffer_.lookupTransform(options_.base_frame, scan->header.frame_id, ros::Time(0)).transform);
   } catch (const tf2::TransformException& error) {
@@ -141,7 +143,7 @@ void Explorer::onScan(const sensor_msgs::LaserScan::ConstPtr& scan) {
   }
   try {
     int skipped = 0;
-    scan_points_ = obstaclePoints(fromRos(*scan, sensor), &skipped);
+    scan_points_ = exploration::obstaclePoints(fromRos(*scan, sensor), &skipped);
     scan_remembered_ = false;
     int non_finite = 0;
     for (float range : scan->ranges) non_finite += !std::isfinite(range);
@@ -149,12 +151,12 @@ void Explorer::onScan(const sensor_msgs::LaserScan::ConstPtr& scan) {
       ROS_WARN_THROTTLE(10.0, "explorer: %d of %zu ranges of a scan are not finite; skipped", non_finite,
                         scan->ranges.size());
     latest_scan_ = scan;
-  } catch (const InputError& error) {
+  } catch (const common::InputError& error) {
     ROS_WARN_THROTTLE(5.0, "explorer: bad scan: %s", error.what());
   }
 }
 
-bool Explorer::robotPose(Pose2* pose) {
+bool Explorer::robotPose(common::Pose2* pose) {
   try {
     const geometry_msgs::TransformStamped transform =
         tf_buffer_.lookupTransform(options_.map_frame, options_.base_frame, ros::Time(0));
@@ -174,7 +176,7 @@ bool Explorer::robotPose(Pose2* pose) {
 
 void Explorer::holdRobot(const ros::Time& now) {
   policy_.hold(now.toSec());
-  publishCommand(VelocityCommand());
+  publishCommand(common::VelocityCommand());
 }
 
 void Explorer::onTimer(const ros::TimerEvent&) {
@@ -183,7 +185,7 @@ void Explorer::onTimer(const ros::TimerEvent&) {
     ROS_INFO_THROTTLE(10.0, "explorer: waiting for a map on %s", map_subscriber_.getTopic().c_str());
     return;
   }
-  Pose2 pose;
+  common::Pose2 pose;
   if (!robotPose(&pose)) {
     holdRobot(now);
     return;
@@ -217,64 +219,64 @@ void Explorer::onTimer(const ros::TimerEvent&) {
     policy_.addScan(scan_points_, pose, now.toSec());
     scan_remembered_ = true;
   }
-  const ExplorationStep step = policy_.update(pose, now.toSec());
+  const exploration::ExplorationStep step = policy_.update(pose, now.toSec());
   report(step, now);
   if (step.planned) publishMarkers(now);
   publishCommand(step.command);
 }
 
-void Explorer::report(const ExplorationStep& step, const ros::Time& now) {
-  for (const ExplorationEvent& event : step.events) {
+void Explorer::report(const exploration::ExplorationStep& step, const ros::Time& now) {
+  for (const exploration::ExplorationEvent& event : step.events) {
     const double x = event.position.x(), y = event.position.y();
     switch (event.type) {
-      case ExplorationEventType::kMapUnusable:
+      case exploration::ExplorationEventType::kMapUnusable:
         ROS_WARN_THROTTLE(5.0, "explorer: unusable map: %s", event.message.c_str());
         break;
-      case ExplorationEventType::kStartBlocked:
+      case exploration::ExplorationEventType::kStartBlocked:
         ROS_WARN_THROTTLE(5.0, "explorer: robot at (%.2f, %.2f) is not within %.2f m of a traversable map cell; "
                           "waiting for the map (or a recovery) to free it", x, y,
                           options_.planner.start_escape_radius);
         break;
-      case ExplorationEventType::kGoalChosen:
+      case exploration::ExplorationEventType::kGoalChosen:
         ++goals_chosen_;
         ROS_DEBUG("explorer: goal (%.2f, %.2f), path %.2f m, cost %.2f", x, y, event.path_length, event.cost);
         break;
-      case ExplorationEventType::kGoalReached:
+      case exploration::ExplorationEventType::kGoalReached:
         break;
-      case ExplorationEventType::kGoalFailedStuck:
+      case exploration::ExplorationEventType::kGoalFailedStuck:
         ROS_WARN("explorer: goal (%.2f, %.2f) failed: the robot did not move in %d recoveries (stuck?); "
                  "blacklisted until no other goal is left", x, y, event.recoveries);
         break;
-      case ExplorationEventType::kGoalFailed:
+      case exploration::ExplorationEventType::kGoalFailed:
         ROS_WARN("explorer: goal (%.2f, %.2f) not reached (%d recoveries, no progress); blacklisted (%s)", x, y,
                  event.recoveries,
                  event.retry_later ? "a second try when no other goal is left" : "it failed there on its second try");
         break;
-      case ExplorationEventType::kPassageBlocked:
+      case exploration::ExplorationEventType::kPassageBlocked:
         ROS_WARN("explorer: %d goals failed from (%.2f, %.2f) in one direction: the path ahead is blocked for the "
                  "planner", options_.passages.failures, x, y);
         break;
-      case ExplorationEventType::kPassageOpened:
+      case exploration::ExplorationEventType::kPassageOpened:
         ROS_WARN("explorer: goals failed from (%.2f, %.2f) in different directions: the robot is stuck there, not "
                  "a passage ahead; opened again", x, y);
         break;
-      case ExplorationEventType::kStuckReleased:
+      case exploration::ExplorationEventType::kStuckReleased:
         ROS_WARN("explorer: no other goal; %zu goals failed while the robot could not move: trying them again",
                  event.count);
         break;
-      case ExplorationEventType::kPassagesReleased:
+      case exploration::ExplorationEventType::kPassagesReleased:
         ROS_WARN("explorer: no other goal; opening the blocked passages again (%zu points, once)", event.count);
         break;
-      case ExplorationEventType::kFailedReleased:
+      case exploration::ExplorationEventType::kFailedReleased:
         ROS_WARN("explorer: no other goal; %zu failed goals get their second try", event.count);
         break;
-      case ExplorationEventType::kNoGoal:
+      case exploration::ExplorationEventType::kNoGoal:
         ROS_INFO("explorer: no reachable frontier (%zu frontiers, %zu blacklisted places); checking again",
                  event.count, event.blacklisted);
         break;
-      case ExplorationEventType::kDone:
-      case ExplorationEventType::kResumed: {
-        const bool done = event.type == ExplorationEventType::kDone;
+      case exploration::ExplorationEventType::kDone:
+      case exploration::ExplorationEventType::kResumed: {
+        const bool done = event.type == exploration::ExplorationEventType::kDone;
         std_msgs::Bool message;
         message.data = done;
         done_publisher_.publish(message);
@@ -289,7 +291,7 @@ void Explorer::report(const ExplorationStep& step, const ros::Time& now) {
   }
 }
 
-void Explorer::publishCommand(const VelocityCommand& command) {
+void Explorer::publishCommand(const common::VelocityCommand& command) {
   const bool stop = command.linear == 0.0 && command.angular == 0.0;
   if (stop && stopped_) return;  // one stop is enough (the simulator's watchdog also stops a silent robot)
   stopped_ = stop;

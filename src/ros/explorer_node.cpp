@@ -13,7 +13,7 @@ int main(int argc, char** argv) {
              ros::names::resolve("map").c_str(), ros::names::resolve("base_scan").c_str(),
              options.planner.robot_radius);
     ros::spin();
-  } catch (const hidden_rooms::InputError& error) {
+  } catch (const hidden_rooms::common::InputError& error) {
     ROS_FATAL("explorer: %s", error.what());
     return 2;
   }

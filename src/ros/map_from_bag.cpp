@@ -30,8 +30,8 @@
 #include "hidden_rooms/world/render.h"
 
 namespace po = boost::program_options;
-using hidden_rooms::InputError;
-using hidden_rooms::Pose2;
+using hidden_rooms::common::InputError;
+using hidden_rooms::common::Pose2;
 
 namespace {
 
@@ -87,14 +87,15 @@ int run(int argc, char** argv) {
   po::positional_options_description positional;
   positional.add("bag", 1);
   po::variables_map values;
-  if (!hidden_rooms::parseCommandLine(
+  if (!hidden_rooms::common::parseCommandLine(
           argc, argv,
-          "Usage: map_from_bag BAG --out PREFIX [--config rbpf.ini] [--seed N] [--environment ENV.xml [--metrics F.yaml]]\n"
+          "Usage: map_from_bag BAG --out PREFIX [--config rbpf.ini] [--seed N] [--environment ENV.xml [--metrics "
+          "F.yaml]]\n"
           "Builds the mapper's map (MRPT RBPF) from the bag's scans and tf odom -> base_link, as fast as the CPU\n"
           "allows, and writes it as map_server files. With --environment also prints map quality and trajectory\n"
           "error against the rendered ground truth (true poses from --truth-topic).",
           options, positional, &values))
-    return hidden_rooms::kExitOk;
+    return hidden_rooms::common::kExitOk;
   if (seed < 0) throw InputError("--seed", "must be zero or positive");
   if (config.empty()) config = defaultConfig();
   if (config.empty()) throw InputError("--config", "not given and the package's config/rbpf.ini was not found");
@@ -102,16 +103,16 @@ int run(int argc, char** argv) {
   if (!comparison_path.empty() && environment_path.empty()) throw InputError("--comparison", "needs --environment");
 
   // Inputs first: nothing is written on bad input.
-  hidden_rooms::RenderedEnvironment truth;
+  hidden_rooms::world::RenderedEnvironment truth;
   if (!environment_path.empty()) {
-    const hidden_rooms::Environment environment = hidden_rooms::loadEnvironment(environment_path);
-    truth = hidden_rooms::renderEnvironment(environment,
-                                            hidden_rooms::parseDoorSelection(environment, closed, "--closed-doors"));
+    const hidden_rooms::world::Environment environment = hidden_rooms::world::loadEnvironment(environment_path);
+    truth = hidden_rooms::world::renderEnvironment(
+        environment, hidden_rooms::world::parseDoorSelection(environment, closed, "--closed-doors"));
   }
-  hidden_rooms::RbpfMapperOptions mapper_options;
+  hidden_rooms::mapping::RbpfMapperOptions mapper_options;
   mapper_options.config_file = config;
   mapper_options.seed = static_cast<uint32_t>(seed);
-  hidden_rooms::RbpfMapper mapper(mapper_options);
+  hidden_rooms::mapping::RbpfMapper mapper(mapper_options);
 
   rosbag::Bag bag;
   try {
@@ -135,7 +136,7 @@ int run(int argc, char** argv) {
   std::vector<TimedPose> true_poses;
   std::vector<double> scan_times;
   std::vector<Pose2> estimate;
-  std::vector<std::pair<double, hidden_rooms::RangeScan>> inserted_scans;  // for the observed cells
+  std::vector<std::pair<double, hidden_rooms::common::RangeScan>> inserted_scans;  // for the observed cells
   int processed = 0, dropped = 0, received = 0, without_returns = 0;
   std::string last_tf_error;
   const Clock::time_point start = Clock::now();
@@ -202,27 +203,32 @@ int run(int argc, char** argv) {
                                                              : "no scan has odometry (" + odom_frame + " -> " +
                                                                    base_frame + " in /tf) at its stamp: " + last_tf_error);
 
-  const hidden_rooms::OccupancyGrid map = mapper.map();
-  const std::string yaml = hidden_rooms::saveMap(map, prefix);
+  const hidden_rooms::common::OccupancyGrid map = mapper.map();
+  const std::string yaml = hidden_rooms::common::saveMap(map, prefix);
   std::printf("bag: %s\nmap: %s\nscans: %d\nscans_inserted: %d\nscans_dropped: %d\nbag_seconds: %.2f\n"
               "wall_seconds: %.2f\nspeed_factor: %.1f\n",
               bag_path.c_str(), yaml.c_str(), processed, mapper.scansInserted(), dropped, bag_seconds, wall_seconds,
               bag_seconds / std::max(wall_seconds, 1e-9));
-  if (environment_path.empty()) return hidden_rooms::kExitOk;
+  if (environment_path.empty()) return hidden_rooms::common::kExitOk;
 
   if (true_poses.empty()) throw InputError(bag_path, "no nav_msgs/Odometry on " + truth_topic + " to score against");
   std::sort(true_poses.begin(), true_poses.end(), [](const TimedPose& a, const TimedPose& b) { return a.time < b.time; });
   std::vector<Pose2> truth_at_scans;
   for (double t : scan_times) truth_at_scans.push_back(interpolate(true_poses, t));
-  const Pose2 world_from_map = hidden_rooms::composePoses(truth_at_scans.back(), hidden_rooms::invertPose(estimate.back()));
+  const Pose2 world_from_map =
+      hidden_rooms::common::composePoses(truth_at_scans.back(), hidden_rooms::common::invertPose(estimate.back()));
   cv::Mat1b observed;
   for (const auto& [time, scan] : inserted_scans)
-    hidden_rooms::markObservedCells(truth.map, hidden_rooms::composePoses(interpolate(true_poses, time), scan.sensor_pose),
-                                    scan, &observed);
-  const hidden_rooms::MapQuality quality = hidden_rooms::evaluateMap(map, world_from_map, truth.map, observed);
+    hidden_rooms::evaluation::markObservedCells(
+        truth.map, hidden_rooms::common::composePoses(interpolate(true_poses, time), scan.sensor_pose), scan,
+        &observed);
+  const hidden_rooms::evaluation::MapQuality quality =
+      hidden_rooms::evaluation::evaluateMap(map, world_from_map, truth.map, observed);
   if (!comparison_path.empty())
-    hidden_rooms::writeImage(comparison_path, hidden_rooms::drawMapComparison(map, world_from_map, truth.map, observed));
-  const hidden_rooms::TrajectoryError trajectory = hidden_rooms::trajectoryError(estimate, truth_at_scans, world_from_map);
+    hidden_rooms::common::writeImage(
+        comparison_path, hidden_rooms::evaluation::drawMapComparison(map, world_from_map, truth.map, observed));
+  const hidden_rooms::evaluation::TrajectoryError trajectory =
+      hidden_rooms::evaluation::trajectoryError(estimate, truth_at_scans, world_from_map);
   char text[1024];
   std::snprintf(text, sizeof(text),
                 "free_iou: %.4f\ntrue_free_cells: %lld\nmap_free_cells: %lld\nwalls_within_2_cells: %.4f\n"
@@ -237,13 +243,13 @@ int run(int argc, char** argv) {
     out << "bag: " << bag_path << "\nbag_seconds: " << bag_seconds << "\nwall_seconds: " << wall_seconds
         << "\nspeed_factor: " << bag_seconds / std::max(wall_seconds, 1e-9) << "\nscans: " << processed
         << "\nscans_inserted: " << mapper.scansInserted() << "\n" << text;
-    hidden_rooms::writeTextAtomically(metrics_path, out.str(), "metrics file");
+    hidden_rooms::common::writeTextAtomically(metrics_path, out.str(), "metrics file");
   }
-  return hidden_rooms::kExitOk;
+  return hidden_rooms::common::kExitOk;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  return hidden_rooms::runTool("map_from_bag", [&] { return run(argc, argv); });
+  return hidden_rooms::common::runTool("map_from_bag", [&] { return run(argc, argv); });
 }

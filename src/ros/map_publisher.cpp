@@ -21,19 +21,20 @@ MapPublisherOptions readMapPublisherOptions(const ros::NodeHandle& private_nh) {
   if (private_nh.getParam("wall_thickness", wall_thickness) && wall_thickness > 0.0)
     options.render.wall_thickness = wall_thickness;
   if (options.map_file.empty() == options.environment.empty())
-    throw InputError(private_nh.getNamespace(), "set exactly one of ~map_file and ~environment");
+    throw common::InputError(private_nh.getNamespace(), "set exactly one of ~map_file and ~environment");
   return options;
 }
 
 MapPublisher::MapPublisher(ros::NodeHandle nh, const MapPublisherOptions& options) {
-  OccupancyGrid grid;
+  common::OccupancyGrid grid;
   if (!options.map_file.empty()) {
-    grid = loadMap(options.map_file);
+    grid = common::loadMap(options.map_file);
   } else {
-    const Environment environment = loadEnvironment(options.environment);
-    grid = renderEnvironment(environment, parseDoorSelection(environment, options.closed_doors, "~closed_doors"),
-                             options.render)
-               .map;
+    const world::Environment environment = world::loadEnvironment(options.environment);
+    grid =
+        world::renderEnvironment(
+            environment, world::parseDoorSelection(environment, options.closed_doors, "~closed_doors"), options.render)
+            .map;
   }
   map_ = toRos(grid, options.frame_id, ros::Time::now());
   map_publisher_ = nh.advertise<nav_msgs::OccupancyGrid>("map", 1, true);

@@ -10,7 +10,7 @@ int main(int argc, char** argv) {
     hidden_rooms::MapPublisher publisher(nh, hidden_rooms::readMapPublisherOptions(private_nh));
     ROS_INFO("map_publisher: publishing the map on %s", ros::names::resolve("map").c_str());
     ros::spin();
-  } catch (const hidden_rooms::InputError& error) {
+  } catch (const hidden_rooms::common::InputError& error) {
     ROS_FATAL("map_publisher: %s", error.what());
     return 2;
   }

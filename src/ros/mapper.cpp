@@ -19,7 +19,7 @@ MapperOptions readMapperOptions(const ros::NodeHandle& nh) {
   nh.param("config_section", options.rbpf.section, options.rbpf.section);
   int seed = 0;
   nh.param("seed", seed, seed);
-  if (seed < 0) throw InputError("~seed", "must be zero or positive");
+  if (seed < 0) throw common::InputError("~seed", "must be zero or positive");
   options.rbpf.seed = static_cast<uint32_t>(seed);
   nh.param("scan_topic", options.scan_topic, options.scan_topic);
   nh.param("map_frame", options.map_frame, options.map_frame);
@@ -31,21 +31,23 @@ MapperOptions readMapperOptions(const ros::NodeHandle& nh) {
   nh.param("tf_wait", options.tf_wait, options.tf_wait);
   nh.param("future_stamp_tolerance", options.future_stamp_tolerance, options.future_stamp_tolerance);
   nh.param("publish_particles", options.publish_particles, options.publish_particles);
-  if (options.rbpf.config_file.empty()) throw InputError("~config_file", "must name the MRPT ini (config/rbpf.ini)");
+  if (options.rbpf.config_file.empty())
+    throw common::InputError("~config_file", "must name the MRPT ini (config/rbpf.ini)");
   for (const auto& [name, value] : {std::pair<const char*, double>{"map_update_interval", options.map_update_interval},
                                     {"tf_publish_rate", options.tf_publish_rate},
                                     {"transform_tolerance", options.transform_tolerance},
                                     {"tf_wait", options.tf_wait},
                                     {"future_stamp_tolerance", options.future_stamp_tolerance}})
-    if (!std::isfinite(value) || value < 0.0) throw InputError(std::string("~") + name, "must be zero or positive");
+    if (!std::isfinite(value) || value < 0.0)
+      throw common::InputError(std::string("~") + name, "must be zero or positive");
   for (const std::string* frame : {&options.map_frame, &options.odom_frame, &options.base_frame})
-    if (frame->empty()) throw InputError("~map_frame, ~odom_frame, ~base_frame", "must not be empty");
+    if (frame->empty()) throw common::InputError("~map_frame, ~odom_frame, ~base_frame", "must not be empty");
   return options;
 }
 
 Mapper::Mapper(ros::NodeHandle nh, const MapperOptions& options)
     : options_(options),
-      mapper_(std::make_unique<RbpfMapper>(options.rbpf)),
+      mapper_(std::make_unique<mapping::RbpfMapper>(options.rbpf)),
       tf_buffer_(ros::Duration(30.0)),
       tf_listener_(tf_buffer_) {
   scan_subscriber_ = nh.subscribe(options.scan_topic, 50, &Mapper::onScan, this);
@@ -114,7 +116,7 @@ void Mapper::processPending() {
 }
 
 bool Mapper::process(const sensor_msgs::LaserScan& scan) {
-  Pose2 odometry, sensor;
+  common::Pose2 odometry, sensor;
   try {
     odometry = fromRos(tf_buffer_.lookupTransform(options_.odom_frame, options_.base_frame, scan.header.stamp).transform);
     sensor = fromRos(tf_buffer_.lookupTransform(options_.base_frame, scan.header.frame_id, ros::Time(0)).transform);
@@ -125,7 +127,7 @@ bool Mapper::process(const sensor_msgs::LaserScan& scan) {
   }
   try {
     mapper_->addScan(odometry, toMrptScan(scan, sensor));
-  } catch (const InputError& error) {
+  } catch (const common::InputError& error) {
     ROS_WARN_THROTTLE(5.0, "mapper: bad scan: %s", error.what());
     ++dropped_;
     return false;
@@ -144,7 +146,7 @@ bool Mapper::process(const sensor_msgs::LaserScan& scan) {
 }
 
 void Mapper::publishMap(const ros::Time& stamp) {
-  const OccupancyGrid grid = mapper_->map();
+  const common::OccupancyGrid grid = mapper_->map();
   if (grid.empty()) return;
   const nav_msgs::OccupancyGrid message = toRos(grid, options_.map_frame, stamp);
   map_publisher_.publish(message);
@@ -165,7 +167,7 @@ void Mapper::publishTransform(const ros::Time& stamp) {
 void Mapper::onTimer(const ros::TimerEvent&) { publishTransform(ros::Time::now()); }
 
 bool Mapper::onSaveMap(hidden_rooms::SaveMap::Request& request, hidden_rooms::SaveMap::Response& response) {
-  const OccupancyGrid grid = mapper_->map();
+  const common::OccupancyGrid grid = mapper_->map();
   if (grid.empty()) {
     response.success = false;
     response.message = "no map yet: no scan has been processed";
@@ -177,9 +179,9 @@ bool Mapper::onSaveMap(hidden_rooms::SaveMap::Request& request, hidden_rooms::Sa
     return true;
   }
   try {
-    response.message = saveMap(grid, request.prefix);
+    response.message = common::saveMap(grid, request.prefix);
     response.success = true;
-  } catch (const InputError& error) {
+  } catch (const common::InputError& error) {
     response.success = false;
     response.message = error.what();
   }

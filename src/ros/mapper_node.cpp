@@ -13,7 +13,7 @@ int main(int argc, char** argv) {
              options.rbpf.seed, ros::names::resolve(options.scan_topic).c_str(), options.map_frame.c_str(),
              options.odom_frame.c_str(), options.base_frame.c_str());
     ros::spin();
-  } catch (const hidden_rooms::InputError& error) {
+  } catch (const hidden_rooms::common::InputError& error) {
     ROS_FATAL("mapper: %s", error.what());
     return 2;
   }

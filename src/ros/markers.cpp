@@ -22,13 +22,14 @@ std_msgs::ColorRGBA colour(double r, double g, double b, double a) {
 }
 
 std_msgs::ColorRGBA roomColourRgba(int label, double alpha) {
-  const cv::Vec3b bgr = roomColour(label);
+  const cv::Vec3b bgr = common::roomColour(label);
   return colour(bgr[2] / 255.0, bgr[1] / 255.0, bgr[0] / 255.0, alpha);
 }
 
 // A map-frame point of continuous image coordinates (x = column, y = row from the top).
-geometry_msgs::Point imagePoint(const OccupancyGrid& map, double x, double y, double z) {
-  return toRos(Point2(map.origin.x() + x * map.resolution, map.origin.y() + (map.height() - y) * map.resolution), z);
+geometry_msgs::Point imagePoint(const common::OccupancyGrid& map, double x, double y, double z) {
+  return toRos(
+      common::Point2(map.origin.x() + x * map.resolution, map.origin.y() + (map.height() - y) * map.resolution), z);
 }
 
 visualization_msgs::Marker newMarker(const std::string& ns, int id, int type, const std::string& frame_id,
@@ -56,7 +57,7 @@ visualization_msgs::MarkerArray startArray(const std::string& frame_id, const ro
 }
 
 // Two triangles per axis-aligned image rectangle [x0, x1) x [y0, y1).
-void addRectangle(const OccupancyGrid& map, double x0, double y0, double x1, double y1, double z,
+void addRectangle(const common::OccupancyGrid& map, double x0, double y0, double x1, double y1, double z,
                   const std_msgs::ColorRGBA* vertex_colour, visualization_msgs::Marker* marker) {
   const geometry_msgs::Point a = imagePoint(map, x0, y1, z), b = imagePoint(map, x1, y1, z),
                              c = imagePoint(map, x1, y0, z), d = imagePoint(map, x0, y0, z);
@@ -67,7 +68,8 @@ void addRectangle(const OccupancyGrid& map, double x0, double y0, double x1, dou
 }
 
 // The cells of a mask as few rectangles: runs of each row, stacked while the next row has the same run.
-void addMaskTriangles(const OccupancyGrid& map, const cv::Mat1b& mask, double z, visualization_msgs::Marker* marker) {
+void addMaskTriangles(const common::OccupancyGrid& map, const cv::Mat1b& mask, double z,
+                      visualization_msgs::Marker* marker) {
   std::vector<cv::Point> cells;
   cv::findNonZero(mask, cells);
   if (cells.empty()) return;
@@ -103,13 +105,13 @@ void addMaskTriangles(const OccupancyGrid& map, const cv::Mat1b& mask, double z,
 
 }  // namespace
 
-visualization_msgs::MarkerArray toMarkers(const OccupancyGrid& map, const DoorsFile& doors,
-                                          const std::vector<RoomPrediction>& rooms, const cv::Mat1w& labels,
+visualization_msgs::MarkerArray toMarkers(const common::OccupancyGrid& map, const common::DoorsFile& doors,
+                                          const std::vector<prediction::RoomPrediction>& rooms, const cv::Mat1w& labels,
                                           const std::string& frame_id, const ros::Time& stamp) {
   using visualization_msgs::Marker;
   visualization_msgs::MarkerArray array = startArray(frame_id, stamp);
   for (size_t k = 0; k < rooms.size(); ++k) {
-    const RoomPrediction& room = rooms[k];
+    const prediction::RoomPrediction& room = rooms[k];
     const int label = static_cast<int>(k) + 1;
     if (!room.placed) continue;
     const cv::Mat1b cells = labels == label;
@@ -121,7 +123,7 @@ visualization_msgs::MarkerArray toMarkers(const OccupancyGrid& map, const DoorsF
       Marker outline = newMarker("outlines", room.door_id, Marker::LINE_STRIP, frame_id, stamp);
       outline.scale.x = 2.0 * map.resolution;
       outline.color = roomColourRgba(label, 1.0);
-      for (const Point2& p : room.polygon) outline.points.push_back(toRos(p, 0.02));
+      for (const common::Point2& p : room.polygon) outline.points.push_back(toRos(p, 0.02));
       outline.points.push_back(outline.points.front());
       array.markers.push_back(outline);
     }
@@ -141,11 +143,13 @@ visualization_msgs::MarkerArray toMarkers(const OccupancyGrid& map, const DoorsF
   Marker door_lines = newMarker("doors", 0, Marker::LINE_LIST, frame_id, stamp);
   door_lines.scale.x = 0.3;  // metres: line width
   for (size_t k = 0; k < doors.doors.size(); ++k) {
-    const MapDoor& door = doors.doors[k];
+    const common::MapDoor& door = doors.doors[k];
     const bool placed = k < rooms.size() && rooms[k].placed;
     const std_msgs::ColorRGBA c = placed ? colour(0.9, 0.1, 0.1, 1.0) : colour(0.5, 0.5, 0.5, 1.0);
-    const Point2 half = door.orientation == DoorOrientation::kAlongX ? Point2(door.width / 2, 0) : Point2(0, door.width / 2);
-    for (const Point2& p : {Point2(door.position - half), Point2(door.position + half)}) {
+    const common::Point2 half = door.orientation == common::DoorOrientation::kAlongX
+                                    ? common::Point2(door.width / 2, 0)
+                                    : common::Point2(0, door.width / 2);
+    for (const common::Point2& p : {common::Point2(door.position - half), common::Point2(door.position + half)}) {
       door_lines.points.push_back(toRos(p, 0.03));
       door_lines.colors.push_back(c);
     }
@@ -154,19 +158,19 @@ visualization_msgs::MarkerArray toMarkers(const OccupancyGrid& map, const DoorsF
   return array;
 }
 
-visualization_msgs::MarkerArray toDebugMarkers(const OccupancyGrid& map, const Layout& layout,
+visualization_msgs::MarkerArray toDebugMarkers(const common::OccupancyGrid& map, const prediction::Layout& layout,
                                                const std::string& frame_id, const ros::Time& stamp) {
   using visualization_msgs::Marker;
   visualization_msgs::MarkerArray array;
-  const CellGrid& grid = layout.grid;
+  const prediction::CellGrid& grid = layout.grid;
   if (grid.xs.size() < 2 || grid.ys.size() < 2) return array;
   Marker lines = newMarker("debug_extended_lines", 0, Marker::LINE_LIST, frame_id, stamp);
   lines.scale.x = map.resolution;
-  for (const ExtendedLine& line : layout.lines) {
-    const std_msgs::ColorRGBA c = line.source == LineSource::kWall       ? colour(0.2, 0.4, 1.0, 1.0)
-                                  : line.source == LineSource::kDoorPair ? colour(1.0, 0.6, 0.0, 1.0)
-                                                                         : colour(0.6, 0.6, 0.6, 1.0);
-    if (line.axis == LineAxis::kHorizontal) {
+  for (const prediction::ExtendedLine& line : layout.lines) {
+    const std_msgs::ColorRGBA c = line.source == prediction::LineSource::kWall       ? colour(0.2, 0.4, 1.0, 1.0)
+                                  : line.source == prediction::LineSource::kDoorPair ? colour(1.0, 0.6, 0.0, 1.0)
+                                                                                     : colour(0.6, 0.6, 0.6, 1.0);
+    if (line.axis == prediction::LineAxis::kHorizontal) {
       lines.points.push_back(imagePoint(map, grid.xs.front(), line.position, 0.04));
       lines.points.push_back(imagePoint(map, grid.xs.back(), line.position, 0.04));
     } else {
@@ -178,7 +182,7 @@ visualization_msgs::MarkerArray toDebugMarkers(const OccupancyGrid& map, const L
   }
   if (!lines.points.empty()) array.markers.push_back(lines);
   Marker cells = newMarker("debug_in_out_cells", 0, Marker::TRIANGLE_LIST, frame_id, stamp);
-  for (const LayoutCell& cell : grid.cells) {
+  for (const prediction::LayoutCell& cell : grid.cells) {
     const std_msgs::ColorRGBA c = cell.out ? colour(0.9, 0.2, 0.2, 0.25) : colour(0.2, 0.8, 0.2, 0.25);
     addRectangle(map, cell.rect.x, cell.rect.y, cell.rect.x + cell.rect.width, cell.rect.y + cell.rect.height, 0.005,
                  &c, &cells);
@@ -187,7 +191,7 @@ visualization_msgs::MarkerArray toDebugMarkers(const OccupancyGrid& map, const L
   return array;
 }
 
-visualization_msgs::MarkerArray toMarkers(const OccupancyGrid& map, const ExplorationView& view,
+visualization_msgs::MarkerArray toMarkers(const common::OccupancyGrid& map, const ExplorationView& view,
                                           const std::string& frame_id, const ros::Time& stamp) {
   using visualization_msgs::Marker;
   visualization_msgs::MarkerArray array = startArray(frame_id, stamp);
@@ -196,10 +200,10 @@ visualization_msgs::MarkerArray toMarkers(const OccupancyGrid& map, const Explor
   cells.scale.x = cells.scale.y = map.resolution;
   cells.scale.z = 0.02;
   if (view.frontiers != nullptr) {
-    for (const Frontier& frontier : view.frontiers->frontiers) {
+    for (const exploration::Frontier& frontier : view.frontiers->frontiers) {
       const bool chosen = view.goal && frontier.label == view.goal_frontier_label;
       for (const cv::Point& cell : frontier.cells) {
-        const Point2 centre = map.cellCentre(cell.x, cell.y);
+        const common::Point2 centre = map.cellCentre(cell.x, cell.y);
         cells.points.push_back(toRos(centre, 0.01));
         cells.colors.push_back(chosen ? colour(1.0, 0.5, 0.0, 1.0) : colour(0.1, 0.4, 1.0, 1.0));
       }
@@ -217,19 +221,19 @@ visualization_msgs::MarkerArray toMarkers(const OccupancyGrid& map, const Explor
     Marker path = newMarker("path", 0, Marker::LINE_STRIP, frame_id, stamp);
     path.scale.x = 0.05;
     path.color = colour(0.0, 0.8, 0.2, 1.0);
-    for (const Point2& p : view.path) path.points.push_back(toRos(p, 0.05));
+    for (const common::Point2& p : view.path) path.points.push_back(toRos(p, 0.05));
     if (path.points.size() >= 2) array.markers.push_back(path);
   }
 
   // Places as spheres of `diameter` metres (flattened to `height`) at `z`.
-  const auto spheres = [&](const char* ns, const std::vector<Point2>& places, double diameter, double height,
+  const auto spheres = [&](const char* ns, const std::vector<common::Point2>& places, double diameter, double height,
                            double z, const std_msgs::ColorRGBA& tint) {
     if (places.empty()) return;
     Marker marker = newMarker(ns, 0, Marker::SPHERE_LIST, frame_id, stamp);
     marker.scale.x = marker.scale.y = diameter;
     marker.scale.z = height;
     marker.color = tint;
-    for (const Point2& place : places) marker.points.push_back(toRos(place, z));
+    for (const common::Point2& place : places) marker.points.push_back(toRos(place, z));
     array.markers.push_back(marker);
   };
   spheres("blacklist", view.blacklist, 0.2, 0.2, 0.1, colour(1.0, 0.0, 0.0, 0.8));

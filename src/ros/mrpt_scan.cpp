@@ -11,15 +11,15 @@
 
 namespace hidden_rooms {
 
-mrpt::obs::CObservation2DRangeScan toMrptScan(const sensor_msgs::LaserScan& message, const Pose2& sensor_pose) {
+mrpt::obs::CObservation2DRangeScan toMrptScan(const sensor_msgs::LaserScan& message, const common::Pose2& sensor_pose) {
   const size_t n = message.ranges.size();
-  if (n < 2) throw InputError("scan", "has " + std::to_string(n) + " beams; at least 2 are needed");
+  if (n < 2) throw common::InputError("scan", "has " + std::to_string(n) + " beams; at least 2 are needed");
   if (!std::isfinite(message.angle_min) || !std::isfinite(message.angle_increment) || message.angle_increment == 0.0f)
-    throw InputError("scan", "angle_min and angle_increment must be finite, the increment non-zero");
+    throw common::InputError("scan", "angle_min and angle_increment must be finite, the increment non-zero");
   if (!std::isfinite(message.range_max) || !(message.range_max > 0.0f))
-    throw InputError("scan", "range_max must be positive and finite");
+    throw common::InputError("scan", "range_max must be positive and finite");
   if (!std::isfinite(sensor_pose.x) || !std::isfinite(sensor_pose.y) || !std::isfinite(sensor_pose.yaw))
-    throw InputError("scan", "the pose of frame " + message.header.frame_id + " in base_link is not finite");
+    throw common::InputError("scan", "the pose of frame " + message.header.frame_id + " in base_link is not finite");
 
   // What fromROS expects: beams counter-clockwise from angle_min = -angle_max (it maps MRPT's beams from
   // -aperture/2 on and wraps indices otherwise). The scan's middle direction goes into the sensor pose.
@@ -37,7 +37,7 @@ mrpt::obs::CObservation2DRangeScan toMrptScan(const sensor_msgs::LaserScan& mess
   mrpt::obs::CObservation2DRangeScan scan;
   const mrpt::poses::CPose3D sensor(sensor_pose.x, sensor_pose.y, 0.0, sensor_pose.yaw + middle, 0.0, 0.0);
   if (!mrpt::ros1bridge::fromROS(symmetric, sensor, scan) || scan.getScanSize() != n)
-    throw InputError("scan", "mrpt::ros1bridge could not convert it");
+    throw common::InputError("scan", "mrpt::ros1bridge could not convert it");
   // fromROS picks MRPT beam i from the message beam at the truncated product of two rounded floating-point
   // factors, which for some increments is the neighbour (5 beams 0.01 rad apart come out shifted by one). So
   // each beam is set again from the message by index, with fromROS's validity rule (strictly between range_min

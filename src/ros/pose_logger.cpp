@@ -22,9 +22,9 @@ double openLog(const std::string& path, bool append, std::ofstream* log) {
   const std::filesystem::path folder = std::filesystem::path(path).parent_path();
   std::error_code error;
   if (!folder.empty()) std::filesystem::create_directories(folder, error);
-  const double last_time = append ? preparePoseLogForAppend(path) : -std::numeric_limits<double>::infinity();
+  const double last_time = append ? common::preparePoseLogForAppend(path) : -std::numeric_limits<double>::infinity();
   log->open(path, std::ios::out | (append ? std::ios::app : std::ios::trunc));
-  if (!*log) throw InputError(path, "cannot be written (pose log)");
+  if (!*log) throw common::InputError(path, "cannot be written (pose log)");
   return last_time;
 }
 
@@ -44,10 +44,10 @@ PoseLoggerOptions readPoseLoggerOptions(const ros::NodeHandle& private_nh) {
   private_nh.param("ground_truth_topic", options.ground_truth_topic, options.ground_truth_topic);
   private_nh.param("period", options.period, options.period);
   private_nh.param("append", options.append, options.append);
-  if (!std::isfinite(options.period) || options.period <= 0.0) throw InputError("~period", "must be positive");
-  if (options.estimate_log.empty()) throw InputError("~estimate_log", "must name a file");
+  if (!std::isfinite(options.period) || options.period <= 0.0) throw common::InputError("~period", "must be positive");
+  if (options.estimate_log.empty()) throw common::InputError("~estimate_log", "must name a file");
   if (options.map_frame.empty() || options.base_frame.empty())
-    throw InputError("~map_frame, ~base_frame", "must not be empty");
+    throw common::InputError("~map_frame, ~base_frame", "must not be empty");
   return options;
 }
 
@@ -55,7 +55,7 @@ PoseLogger::PoseLogger(ros::NodeHandle nh, const PoseLoggerOptions& options)
     : options_(options), tf_buffer_(ros::Duration(10.0)), tf_listener_(tf_buffer_) {
   last_estimate_time_ = openLog(options.estimate_log, options.append, &estimate_log_);
   if (emptyFile(options.estimate_log))
-    estimate_log_ << poseLogHeader(options.map_frame, options.base_frame) << std::flush;
+    estimate_log_ << common::poseLogHeader(options.map_frame, options.base_frame) << std::flush;
   if (!options.ground_truth_log.empty()) {
     // Its frames are written with the first message (its header names the world frame).
     last_ground_truth_time_ = openLog(options.ground_truth_log, options.append, &ground_truth_log_);
@@ -85,7 +85,7 @@ void PoseLogger::onTimer(const ros::TimerEvent&) {
     if (tf_buffer_.canTransform(options_.map_frame, options_.base_frame, wanted, &problem)) {
       const geometry_msgs::TransformStamped transform =
           tf_buffer_.lookupTransform(options_.map_frame, options_.base_frame, wanted);
-      estimate_log_ << poseLogLine({next_estimate_time_, fromRos(transform.transform)}) << std::flush;
+      estimate_log_ << common::poseLogLine({next_estimate_time_, fromRos(transform.transform)}) << std::flush;
       ++estimates_logged_;
     } else if (now - next_estimate_time_ < kGiveUpDelay) {
       return;  // the transforms around it may still come
@@ -101,18 +101,18 @@ void PoseLogger::onGroundTruth(const nav_msgs::Odometry::ConstPtr& message) {
   const ros::Time stamp = message->header.stamp;
   if (!last_ground_truth_stamp_.isZero() && (stamp - last_ground_truth_stamp_).toSec() < options_.period - 1e-6)
     return;
-  const Pose2 pose = fromRos(message->pose.pose);
+  const common::Pose2 pose = fromRos(message->pose.pose);
   if (!std::isfinite(pose.x) || !std::isfinite(pose.y) || !std::isfinite(pose.yaw)) {
     ROS_WARN_THROTTLE(10.0, "pose_logger: ground-truth pose with a non-finite value dropped");
     return;
   }
   if (stamp.toSec() <= last_ground_truth_time_ + 1e-6) return;  // already in the continued log
   if (!ground_truth_header_written_) {
-    ground_truth_log_ << poseLogHeader(message->header.frame_id, message->child_frame_id + " (ground truth)");
+    ground_truth_log_ << common::poseLogHeader(message->header.frame_id, message->child_frame_id + " (ground truth)");
     ground_truth_header_written_ = true;
   }
   last_ground_truth_stamp_ = stamp;
-  ground_truth_log_ << poseLogLine({stamp.toSec(), pose}) << std::flush;
+  ground_truth_log_ << common::poseLogLine({stamp.toSec(), pose}) << std::flush;
   ++ground_truth_logged_;
 }
 

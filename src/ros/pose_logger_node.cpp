@@ -15,7 +15,7 @@ int main(int argc, char** argv) {
     ros::spin();
     ROS_INFO("pose_logger: %lld estimated and %lld true poses logged", logger.estimatesLogged(),
              logger.groundTruthLogged());
-  } catch (const hidden_rooms::InputError& error) {
+  } catch (const hidden_rooms::common::InputError& error) {
     ROS_FATAL("pose_logger: %s", error.what());
     return 2;
   }

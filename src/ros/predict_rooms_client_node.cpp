@@ -33,20 +33,21 @@ int run(int argc, char** argv) {
       ("service", po::value(&service_name), "service to call (default: predict_rooms)")
       ("timeout", po::value(&timeout), "seconds to wait for the service and the map (default: 30)");
   po::variables_map values;
-  if (!parseCommandLine(argc, argv,
-                        "Usage: predict_rooms_client --doors DOORS.yaml [--method M] [--map MAP.yaml] [--out DIR]\n"
-                        "       [--params FILE.yaml] [--gt-rooms LABELS.png] [--service NAME] [--timeout S]\n"
-                        "Calls the predict_rooms service (node room_predictor) and writes what predict_rooms_offline\n"
-                        "writes: DIR/rooms.png, DIR/rooms.yaml, DIR/map.yaml + DIR/map.pgm, DIR/overlay.png and,\n"
-                        "with --gt-rooms, DIR/metrics.yaml.",
-                        options, po::positional_options_description(), &values))
-    return kExitOk;
+  if (!common::parseCommandLine(
+          argc, argv,
+          "Usage: predict_rooms_client --doors DOORS.yaml [--method M] [--map MAP.yaml] [--out DIR]\n"
+          "       [--params FILE.yaml] [--gt-rooms LABELS.png] [--service NAME] [--timeout S]\n"
+          "Calls the predict_rooms service (node room_predictor) and writes what predict_rooms_offline\n"
+          "writes: DIR/rooms.png, DIR/rooms.yaml, DIR/map.yaml + DIR/map.pgm, DIR/overlay.png and,\n"
+          "with --gt-rooms, DIR/metrics.yaml.",
+          options, po::positional_options_description(), &values))
+    return common::kExitOk;
 
   // Read and check the files before asking the node anything.
-  PredictionRequest request;
-  request.doors = loadDoors(doors_path);
-  if (!params_path.empty()) request.parameters = loadParameterFile(params_path);
-  if (!map_path.empty()) request.map = loadMap(map_path);
+  prediction::PredictionRequest request;
+  request.doors = common::loadDoors(doors_path);
+  if (!params_path.empty()) request.parameters = prediction::loadParameterFile(params_path);
+  if (!map_path.empty()) request.map = common::loadMap(map_path);
 
   ros::NodeHandle nh;
   PredictRooms service;
@@ -54,33 +55,34 @@ int run(int argc, char** argv) {
     // The map goes into the request, so that the outputs are drawn over the very map the node predicted on.
     const auto map = ros::topic::waitForMessage<nav_msgs::OccupancyGrid>("map", nh, ros::Duration(timeout));
     if (map == nullptr)
-      throw InputError(ros::names::resolve("map"), "no map received within " + std::to_string(timeout) + " s");
+      throw common::InputError(ros::names::resolve("map"), "no map received within " + std::to_string(timeout) + " s");
     service.request.map = *map;
     request.map = fromRos(*map);
   } else {
     service.request.map = toRos(request.map, request.doors.frame, ros::Time::now());
   }
   cv::Mat truth;
-  if (!gt_path.empty()) truth = loadTrueRooms(gt_path, request.map);
+  if (!gt_path.empty()) truth = evaluation::loadTrueRooms(gt_path, request.map);
   service.request.doors = toRos(request.doors);
   service.request.method = method;
   service.request.parameters = toRos(request.parameters);
 
   const std::string resolved = ros::names::resolve(service_name);
   if (!ros::service::waitForService(resolved, ros::Duration(timeout)))
-    throw InputError(resolved, "service not available within " + std::to_string(timeout) + " s");
-  if (!ros::service::call(resolved, service)) throw InputError(resolved, "service call failed");
-  if (!service.response.success) throw InputError(resolved, service.response.message);
+    throw common::InputError(resolved, "service not available within " + std::to_string(timeout) + " s");
+  if (!ros::service::call(resolved, service)) throw common::InputError(resolved, "service call failed");
+  if (!service.response.success) throw common::InputError(resolved, service.response.message);
 
-  PredictionResult result;
+  prediction::PredictionResult result;
   result.seconds = service.response.computation_time;
   for (const PredictedRoom& room : service.response.rooms) result.rooms.push_back(fromRos(room, request.map));
   if (result.rooms.size() != request.doors.doors.size())
-    throw InputError(resolved, "answered " + std::to_string(result.rooms.size()) + " rooms for " +
-                                   std::to_string(request.doors.doors.size()) + " doors");
-  const PredictionOutputs outputs = writePredictionOutputs(request, result, service.response.method, out_dir, truth);
-  printPredictionSummary(std::cout, request, result, service.response.method, out_dir, outputs);
-  return kExitOk;
+    throw common::InputError(resolved, "answered " + std::to_string(result.rooms.size()) + " rooms for " +
+                                           std::to_string(request.doors.doors.size()) + " doors");
+  const evaluation::PredictionOutputs outputs =
+      evaluation::writePredictionOutputs(request, result, service.response.method, out_dir, truth);
+  evaluation::printPredictionSummary(std::cout, request, result, service.response.method, out_dir, outputs);
+  return common::kExitOk;
 }
 
 }  // namespace
@@ -88,5 +90,5 @@ int run(int argc, char** argv) {
 
 int main(int argc, char** argv) {
   ros::init(argc, argv, "predict_rooms_client", ros::init_options::AnonymousName | ros::init_options::NoSigintHandler);
-  return hidden_rooms::runTool("predict_rooms_client", [&] { return hidden_rooms::run(argc, argv); });
+  return hidden_rooms::common::runTool("predict_rooms_client", [&] { return hidden_rooms::run(argc, argv); });
 }

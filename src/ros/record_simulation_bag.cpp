@@ -19,7 +19,7 @@
 #include "hidden_rooms/world/environment.h"
 
 namespace po = boost::program_options;
-using hidden_rooms::InputError;
+using hidden_rooms::common::InputError;
 
 namespace {
 
@@ -37,21 +37,22 @@ int run(int argc, char** argv) {
   po::positional_options_description positional;
   positional.add("world", 1);
   po::variables_map values;
-  if (!hidden_rooms::parseCommandLine(
+  if (!hidden_rooms::common::parseCommandLine(
           argc, argv,
           "Usage: record_simulation_bag WORLD.xml --out BAG [--seconds S] [--closed-doors SPEC] [--seed N]\n"
           "Simulates the robot wandering reactively through the world (the simulator node's defaults: 10 Hz\n"
           "scans, 20 Hz odometry) and writes base_scan, odom, base_pose_ground_truth, /tf and /tf_static.",
           options, positional, &values))
-    return hidden_rooms::kExitOk;
+    return hidden_rooms::common::kExitOk;
   if (!(duration > 0.0) || !std::isfinite(duration)) throw InputError("--seconds", "must be positive");
   if (seed < 0) throw InputError("--seed", "must be zero or positive");
 
-  const hidden_rooms::Environment environment = hidden_rooms::loadEnvironment(world_path);
-  hidden_rooms::SimulationOptions simulation_options;
+  const hidden_rooms::world::Environment environment = hidden_rooms::world::loadEnvironment(world_path);
+  hidden_rooms::simulation::SimulationOptions simulation_options;
   simulation_options.seed = static_cast<uint64_t>(seed);
-  hidden_rooms::Simulation simulation(
-      hidden_rooms::worldFromEnvironment(environment, hidden_rooms::parseDoorSelection(environment, closed, "--closed-doors")),
+  hidden_rooms::simulation::Simulation simulation(
+      hidden_rooms::simulation::worldFromEnvironment(
+          environment, hidden_rooms::world::parseDoorSelection(environment, closed, "--closed-doors")),
       simulation_options);
 
   rosbag::Bag bag;
@@ -63,7 +64,7 @@ int run(int argc, char** argv) {
   const double dt = simulation_options.physics_step;
   const int laser_period = static_cast<int>(std::lround(0.1 / dt)), odom_period = static_cast<int>(std::lround(0.05 / dt));
   const int steps = static_cast<int>(std::lround(duration / dt));
-  hidden_rooms::WanderDriver driver;
+  hidden_rooms::simulation::WanderDriver driver;
   std::vector<float> ranges;
   tf2_msgs::TFMessage fixed;
   fixed.transforms.push_back(hidden_rooms::toTransform(simulation_options.laser.mount, "base_link", "base_laser_link",
@@ -83,7 +84,7 @@ int run(int argc, char** argv) {
     simulation.step();
     const ros::Time stamp(simulation.time());
     if (k % odom_period == 0) {
-      const hidden_rooms::Pose2 odometry = simulation.odometryPose();
+      const hidden_rooms::common::Pose2 odometry = simulation.odometryPose();
       bag.write("odom", stamp, hidden_rooms::toRos(odometry, simulation.odometryVelocity(), "odom", "base_link", stamp));
       bag.write("base_pose_ground_truth", stamp,
                 hidden_rooms::toRos(simulation.truePose(), simulation.velocity(), "world", "base_link", stamp));
@@ -101,11 +102,11 @@ int run(int argc, char** argv) {
   }
   bag.close();
   std::printf("bag: %s\nseconds: %.1f\nscans: %d\n", bag_path.c_str(), duration, steps / laser_period);
-  return hidden_rooms::kExitOk;
+  return hidden_rooms::common::kExitOk;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  return hidden_rooms::runTool("record_simulation_bag", [&] { return run(argc, argv); });
+  return hidden_rooms::common::runTool("record_simulation_bag", [&] { return run(argc, argv); });
 }

@@ -30,21 +30,21 @@ RoomPredictorOptions readRoomPredictorOptions(const ros::NodeHandle& private_nh)
   private_nh.param("octomap_height", options.octomap_height, options.octomap_height);
   private_nh.param("max_doors", options.max_doors, options.max_doors);
   private_nh.param("max_map_cells", options.max_map_cells, options.max_map_cells);
-  if (!(options.octomap_height > 0.0)) throw InputError("~octomap_height", "must be positive");
+  if (!(options.octomap_height > 0.0)) throw common::InputError("~octomap_height", "must be positive");
   if (options.max_doors < 1 || options.max_map_cells < 1)
-    throw InputError("~max_doors, ~max_map_cells", "must be at least 1");
+    throw common::InputError("~max_doors, ~max_map_cells", "must be at least 1");
   if (options.predict_on_map && options.closed_doors_file.empty())
-    throw InputError(private_nh.getNamespace(), "~predict_on_map needs ~closed_doors_file");
+    throw common::InputError(private_nh.getNamespace(), "~predict_on_map needs ~closed_doors_file");
   return options;
 }
 
 RoomPredictorNode::RoomPredictorNode(ros::NodeHandle nh, const RoomPredictorOptions& options) : options_(options) {
   // A bad method, doors file or parameters file stops the node here, not at the first request.
-  const std::unique_ptr<RoomPredictor> method = makeRoomPredictor(options_.method);
-  if (!options_.closed_doors_file.empty()) default_doors_ = loadDoors(options_.closed_doors_file);
+  const std::unique_ptr<prediction::RoomPredictor> method = prediction::makeRoomPredictor(options_.method);
+  if (!options_.closed_doors_file.empty()) default_doors_ = common::loadDoors(options_.closed_doors_file);
   if (!options_.params_file.empty()) {
-    file_parameters_ = loadParameterFile(options_.params_file);
-    resolveParameters(*method, file_parameters_);  // throws for a name no method reads
+    file_parameters_ = prediction::loadParameterFile(options_.params_file);
+    prediction::resolveParameters(*method, file_parameters_);  // throws for a name no method reads
   }
   map_topic_ = nh.resolveName("map");
   predicted_map_publisher_ = nh.advertise<nav_msgs::OccupancyGrid>("predicted_map", 1, true);
@@ -55,13 +55,13 @@ RoomPredictorNode::RoomPredictorNode(ros::NodeHandle nh, const RoomPredictorOpti
     const std::filesystem::path folder = std::filesystem::path(options_.octomap_out).parent_path();
     std::error_code error;
     if (!folder.empty()) std::filesystem::create_directories(folder, error);
-    if (error) throw InputError(options_.octomap_out, "its folder cannot be created: " + error.message());
+    if (error) throw common::InputError(options_.octomap_out, "its folder cannot be created: " + error.message());
   }
   if (!options_.octomap_file.empty()) {
-    SliceOptions slice;
+    map3d::SliceOptions slice;
     slice.z_min = options_.octomap_z_min;
     slice.z_max = options_.octomap_z_max;
-    const OccupancyGrid sliced = sliceOctomap(options_.octomap_file, slice);
+    const common::OccupancyGrid sliced = map3d::sliceOctomap(options_.octomap_file, slice);
     auto message = boost::make_shared<nav_msgs::OccupancyGrid>(toRos(sliced, options_.frame_id, ros::Time(0)));
     // Handled like a map from the topic once the node spins (predict_on_map predicts on it then).
     octomap_timer_ = nh.createWallTimer(
@@ -96,45 +96,46 @@ bool RoomPredictorNode::predictRooms(PredictRooms::Request& request, PredictRoom
 void RoomPredictorNode::predict(const PredictRooms::Request& request, PredictRooms::Response* response) {
   const bool own_map = request.map.info.width > 0 && request.map.info.height > 0;
   if (!own_map && latest_map_ == nullptr)
-    throw InputError("map", "the request has no map and none was received on " + map_topic_ + " yet");
+    throw common::InputError("map", "the request has no map and none was received on " + map_topic_ + " yet");
   const nav_msgs::OccupancyGrid& map_message = own_map ? request.map : *latest_map_;
   const double cells = static_cast<double>(map_message.info.width) * map_message.info.height;
   if (cells > options_.max_map_cells)
-    throw InputError("map", std::to_string(map_message.info.width) + " x " + std::to_string(map_message.info.height) +
-                                " cells is more than ~max_map_cells (" + std::to_string(options_.max_map_cells) + ")");
+    throw common::InputError("map",
+                             std::to_string(map_message.info.width) + " x " + std::to_string(map_message.info.height) +
+                                 " cells is more than ~max_map_cells (" + std::to_string(options_.max_map_cells) + ")");
   if (request.doors.size() > static_cast<size_t>(options_.max_doors))
-    throw InputError("doors", std::to_string(request.doors.size()) + " doors is more than ~max_doors (" +
-                                  std::to_string(options_.max_doors) + ")");
+    throw common::InputError("doors", std::to_string(request.doors.size()) + " doors is more than ~max_doors (" +
+                                          std::to_string(options_.max_doors) + ")");
   const std::string frame = map_message.header.frame_id.empty() ? options_.frame_id : map_message.header.frame_id;
 
-  PredictionRequest core;
+  prediction::PredictionRequest core;
   core.map = fromRos(map_message);
-  checkUsableMap(core.map);
+  prediction::checkUsableMap(core.map);
   if (!request.doors.empty()) {
     core.doors = fromRos(request.doors, frame);
   } else if (default_doors_) {
     core.doors = *default_doors_;
     core.doors.frame = frame;
   } else {
-    throw InputError("doors", "the request has no doors and the node has no ~closed_doors_file");
+    throw common::InputError("doors", "the request has no doors and the node has no ~closed_doors_file");
   }
-  if (core.doors.doors.empty()) throw InputError("doors", "no closed doors to predict");
-  checkDoorsInsideMap(core.map, core.doors);
+  if (core.doors.doors.empty()) throw common::InputError("doors", "no closed doors to predict");
+  prediction::checkDoorsInsideMap(core.map, core.doors);
   core.parameters = file_parameters_;
   for (const auto& [name, value] : fromRos(request.parameters)) core.parameters[name] = value;
   const std::string method = request.method.empty() ? options_.method : request.method;
-  const std::unique_ptr<RoomPredictor> predictor = makeRoomPredictor(method);
+  const std::unique_ptr<prediction::RoomPredictor> predictor = prediction::makeRoomPredictor(method);
 
-  const PredictionResult result = predictor->predict(core);
+  const prediction::PredictionResult result = predictor->predict(core);
 
   const ros::Time stamp = ros::Time::now();
-  const OccupancyGrid completed = insertRooms(core.map, core.doors, result.rooms);
-  const cv::Mat1w labels = roomLabels(core.map, core.doors, result.rooms);
+  const common::OccupancyGrid completed = prediction::insertRooms(core.map, core.doors, result.rooms);
+  const cv::Mat1w labels = prediction::roomLabels(core.map, core.doors, result.rooms);
   std::string not_placed;
   response->rooms.reserve(result.rooms.size());
   int placed = 0;
   for (size_t k = 0; k < result.rooms.size(); ++k) {
-    const RoomPrediction& room = result.rooms[k];
+    const prediction::RoomPrediction& room = result.rooms[k];
     response->rooms.push_back(toRos(room, static_cast<int>(k) + 1, core.map, frame, stamp));
     if (room.placed)
       ++placed;
@@ -154,20 +155,20 @@ void RoomPredictorNode::predict(const PredictRooms::Request& request, PredictRoo
   predicted_map_publisher_.publish(response->completed_map);
   visualization_msgs::MarkerArray markers = toMarkers(core.map, core.doors, result.rooms, labels, frame, stamp);
   if (options_.publish_debug) {
-    LayoutOptions layout_options;
-    applyLayoutParameters(core.parameters, &layout_options);
-    const Layout layout = analyzeLayout(core.map, core.doors.doors, layout_options);
+    prediction::LayoutOptions layout_options;
+    prediction::applyLayoutParameters(core.parameters, &layout_options);
+    const prediction::Layout layout = prediction::analyzeLayout(core.map, core.doors.doors, layout_options);
     const visualization_msgs::MarkerArray debug = toDebugMarkers(core.map, layout, frame, stamp);
     markers.markers.insert(markers.markers.end(), debug.markers.begin(), debug.markers.end());
   }
   markers_publisher_.publish(markers);
 
   if (!options_.octomap_out.empty()) {
-    ExtrusionOptions extrusion;
+    map3d::ExtrusionOptions extrusion;
     extrusion.height = options_.octomap_height;
     try {
-      exportOctomap(completed, labels, extrusion, options_.octomap_out);
-    } catch (const InputError& error) {
+      map3d::exportOctomap(completed, labels, extrusion, options_.octomap_out);
+    } catch (const common::InputError& error) {
       response->success = false;
       response->message += "; but the 3D map was not written: " + std::string(error.what());
     }

@@ -11,7 +11,7 @@ int main(int argc, char** argv) {
     ROS_INFO("room_predictor: serving %s over the maps of %s", ros::names::resolve("predict_rooms").c_str(),
              ros::names::resolve("map").c_str());
     ros::spin();
-  } catch (const hidden_rooms::InputError& error) {
+  } catch (const hidden_rooms::common::InputError& error) {
     ROS_FATAL("room_predictor: %s", error.what());
     return 2;
   }

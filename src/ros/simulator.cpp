@@ -20,10 +20,10 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 
 // A [x, y, yaw] list parameter; false when it is not set or empty.
-bool readPose(const ros::NodeHandle& nh, const std::string& name, Pose2* pose) {
+bool readPose(const ros::NodeHandle& nh, const std::string& name, common::Pose2* pose) {
   std::vector<double> values;
   if (!nh.getParam(name, values) || values.empty()) return false;
-  if (values.size() != 3) throw InputError("~" + name, "must be a list [x, y, yaw]");
+  if (values.size() != 3) throw common::InputError("~" + name, "must be a list [x, y, yaw]");
   *pose = {values[0], values[1], values[2]};
   return true;
 }
@@ -35,12 +35,13 @@ std::string readText(const ros::NodeHandle& nh, const std::string& name, const s
   switch (value.getType()) {
     case XmlRpc::XmlRpcValue::TypeString: return static_cast<std::string>(value);
     case XmlRpc::XmlRpcValue::TypeInt: return std::to_string(static_cast<int>(value));
-    default: throw InputError("~" + name, "must be text (door numbers or ids, comma-separated, or 'all')");
+    default:
+      throw common::InputError("~" + name, "must be text (door numbers or ids, comma-separated, or 'all')");
   }
 }
 
 uint64_t periodInSteps(double rate, double physics_step, const std::string& name) {
-  if (!std::isfinite(rate) || rate <= 0.0) throw InputError("~" + name, "must be positive");
+  if (!std::isfinite(rate) || rate <= 0.0) throw common::InputError("~" + name, "must be positive");
   return std::max<uint64_t>(1, static_cast<uint64_t>(std::llround(1.0 / (rate * physics_step))));
 }
 
@@ -57,13 +58,13 @@ SimulatorOptions readSimulatorOptions(const ros::NodeHandle& nh) {
   double wall_thickness = 0.0;
   if (nh.getParam("wall_thickness", wall_thickness) && wall_thickness > 0.0) options.render.wall_thickness = wall_thickness;
 
-  SimulationOptions& simulation = options.simulation;
+  simulation::SimulationOptions& simulation = options.simulation;
   nh.param("physics_step", simulation.physics_step, simulation.physics_step);
   int seed = 0;
   nh.param("seed", seed, seed);
-  if (seed < 0) throw InputError("~seed", "must be zero or positive");
+  if (seed < 0) throw common::InputError("~seed", "must be zero or positive");
   simulation.seed = static_cast<uint64_t>(seed);
-  RobotOptions& robot = simulation.robot;
+  simulation::RobotOptions& robot = simulation.robot;
   nh.param("footprint_length", robot.length, robot.length);
   nh.param("footprint_width", robot.width, robot.width);
   nh.param("max_linear_velocity", robot.max_linear_velocity, robot.max_linear_velocity);
@@ -71,7 +72,7 @@ SimulatorOptions readSimulatorOptions(const ros::NodeHandle& nh) {
   nh.param("linear_acceleration", robot.linear_acceleration, robot.linear_acceleration);
   nh.param("angular_acceleration", robot.angular_acceleration, robot.angular_acceleration);
   nh.param("watchdog_timeout", robot.watchdog_timeout, robot.watchdog_timeout);
-  LaserOptions& laser = simulation.laser;
+  simulation::LaserOptions& laser = simulation.laser;
   nh.param("laser_beams", laser.beams, laser.beams);
   double field_of_view_degrees = laser.field_of_view * 180.0 / kPi;
   nh.param("laser_field_of_view", field_of_view_degrees, field_of_view_degrees);
@@ -83,12 +84,12 @@ SimulatorOptions readSimulatorOptions(const ros::NodeHandle& nh) {
   readPose(nh, "laser_pose", &laser.mount);
   std::string caster = toString(laser.caster);
   nh.param("laser_caster", caster, caster);
-  laser.caster = laserCasterFromString(caster);
+  laser.caster = simulation::laserCasterFromString(caster);
   nh.param("laser_grid_resolution", laser.grid_resolution, laser.grid_resolution);
-  Pose2 odom_error{simulation.odometry_noise.x, simulation.odometry_noise.y, simulation.odometry_noise.yaw};
+  common::Pose2 odom_error{simulation.odometry_noise.x, simulation.odometry_noise.y, simulation.odometry_noise.yaw};
   readPose(nh, "odom_error", &odom_error);
   simulation.odometry_noise = {odom_error.x, odom_error.y, odom_error.yaw};
-  Pose2 start;
+  common::Pose2 start;
   if (readPose(nh, "start_pose", &start)) simulation.start_pose = start;
   validate(simulation);
 
@@ -103,35 +104,35 @@ SimulatorOptions readSimulatorOptions(const ros::NodeHandle& nh) {
   nh.param("laser_frame", options.laser_frame, options.laser_frame);
   nh.param("publish_world_to_odom", options.publish_world_to_odom, options.publish_world_to_odom);
   if (!std::isfinite(options.realtime_factor) || options.realtime_factor < 0.0)
-    throw InputError("~realtime_factor", "must be zero (as fast as possible) or positive");
+    throw common::InputError("~realtime_factor", "must be zero (as fast as possible) or positive");
   if (!std::isfinite(options.duration) || options.duration < 0.0)
-    throw InputError("~duration", "must be zero (no limit) or positive");
+    throw common::InputError("~duration", "must be zero (no limit) or positive");
   if (!std::isfinite(options.bitmap_resolution) || options.bitmap_resolution <= 0.0)
-    throw InputError("~bitmap_resolution", "must be positive");
+    throw common::InputError("~bitmap_resolution", "must be positive");
   const int sources = !options.environment.empty() + !options.map_file.empty() + !options.bitmap.empty();
   if (sources != 1)
-    throw InputError(nh.getNamespace(), "set exactly one of ~environment, ~map_file and ~bitmap");
+    throw common::InputError(nh.getNamespace(), "set exactly one of ~environment, ~map_file and ~bitmap");
   if (options.environment.empty() && !options.closed_doors.empty())
-    throw InputError("~closed_doors", "applies to ~environment worlds only");
+    throw common::InputError("~closed_doors", "applies to ~environment worlds only");
   return options;
 }
 
 Simulator::Simulator(ros::NodeHandle nh, const SimulatorOptions& options) : options_(options) {
-  SimulationWorld world;
+  simulation::SimulationWorld world;
   if (!options.environment.empty()) {
-    const Environment environment = loadEnvironment(options.environment);
-    world = worldFromEnvironment(environment, parseDoorSelection(environment, options.closed_doors, "~closed_doors"),
-                                 options.render);
+    const world::Environment environment = world::loadEnvironment(options.environment);
+    world = simulation::worldFromEnvironment(
+        environment, world::parseDoorSelection(environment, options.closed_doors, "~closed_doors"), options.render);
   } else if (!options.map_file.empty()) {
-    world = worldFromGrid(loadMap(options.map_file));
+    world = simulation::worldFromGrid(common::loadMap(options.map_file));
   } else {
-    const cv::Mat image = readImage(options.bitmap);
-    MapMetadata metadata;
+    const cv::Mat image = common::readImage(options.bitmap);
+    common::MapMetadata metadata;
     metadata.image = options.bitmap;
     metadata.resolution = options.bitmap_resolution;
-    world = worldFromGrid(gridFromImage(image, metadata));
+    world = simulation::worldFromGrid(common::gridFromImage(image, metadata));
   }
-  simulation_ = std::make_unique<Simulation>(world, options.simulation);
+  simulation_ = std::make_unique<simulation::Simulation>(world, options.simulation);
   const double dt = options.simulation.physics_step;
   laser_period_steps_ = periodInSteps(options.laser_rate, dt, "laser_rate");
   odom_period_steps_ = periodInSteps(options.odom_rate, dt, "odom_rate");
@@ -208,7 +209,7 @@ void Simulator::publishScan() {
 
 void Simulator::publishOdometry() {
   const ros::Time stamp = now();
-  const Pose2 odometry = simulation_->odometryPose();
+  const common::Pose2 odometry = simulation_->odometryPose();
   odom_publisher_.publish(toRos(odometry, simulation_->odometryVelocity(), options_.odom_frame, options_.base_frame, stamp));
   ground_truth_publisher_.publish(
       toRos(simulation_->truePose(), simulation_->velocity(), options_.world_frame, options_.base_frame, stamp));
@@ -218,14 +219,14 @@ void Simulator::publishOdometry() {
 void Simulator::onCommand(const geometry_msgs::Twist::ConstPtr& command) {
   try {
     simulation_->setCommand(fromRos(*command));
-  } catch (const InputError& error) {
+  } catch (const common::InputError& error) {
     ROS_WARN_THROTTLE(1.0, "simulator: ignoring %s", error.what());
   }
 }
 
 bool Simulator::onReset(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& response) {
   simulation_->reset();
-  const Pose2& start = simulation_->startPose();
+  const common::Pose2& start = simulation_->startPose();
   response.success = true;
   response.message = "robot back at its start pose (" + std::to_string(start.x) + ", " + std::to_string(start.y) +
                      ", " + std::to_string(start.yaw) + "), odometry at zero";
@@ -236,10 +237,10 @@ bool Simulator::onSetDoor(hidden_rooms::SetDoor::Request& request, hidden_rooms:
   try {
     simulation_->setDoor(request.door, request.open);
     const int index = simulation_->world().findDoor(request.door);
-    const SimulationWorld::DoorLeaf& door = simulation_->world().doors[index];
+    const simulation::SimulationWorld::DoorLeaf& door = simulation_->world().doors[index];
     response.success = true;
     response.message = "door " + std::to_string(door.number) + " (" + door.id + ") " + (request.open ? "open" : "closed");
-  } catch (const InputError& error) {
+  } catch (const common::InputError& error) {
     response.success = false;
     response.message = error.what();
   }

@@ -8,12 +8,12 @@ int main(int argc, char** argv) {
   ros::NodeHandle nh, private_nh("~");
   try {
     hidden_rooms::Simulator simulator(nh, hidden_rooms::readSimulatorOptions(private_nh));
-    const hidden_rooms::Pose2& start = simulator.simulation().startPose();
-    ROS_INFO("simulator: robot at (%.2f, %.2f, %.2f), %d static fixtures, laser caster %s", start.x, start.y,
-             start.yaw, simulator.simulation().staticFixtureCount(),
-             hidden_rooms::toString(simulator.simulation().options().laser.caster));
+    const hidden_rooms::common::Pose2& start = simulator.simulation().startPose();
+    ROS_INFO("simulator: robot at (%.2f, %.2f, %.2f), %d static fixtures, laser caster %s", start.x, start.y, start.yaw,
+             simulator.simulation().staticFixtureCount(),
+             hidden_rooms::simulation::toString(simulator.simulation().options().laser.caster));
     simulator.run();
-  } catch (const hidden_rooms::InputError& error) {
+  } catch (const hidden_rooms::common::InputError& error) {
     ROS_FATAL("simulator: %s", error.what());
     return 2;
   }

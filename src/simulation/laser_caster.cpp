@@ -5,7 +5,7 @@
 
 #include <box2d/box2d.h>
 
-namespace hidden_rooms {
+namespace hidden_rooms::simulation {
 
 namespace {
 
@@ -27,7 +27,8 @@ class ClosestHit : public b2RayCastCallback {
 
 }  // namespace
 
-void Box2dLaserCaster::cast(const Pose2& laser_pose, const LaserGeometry& laser, std::vector<float>* ranges) const {
+void Box2dLaserCaster::cast(const common::Pose2& laser_pose, const common::LaserGeometry& laser,
+                            std::vector<float>* ranges) const {
   ranges->resize(static_cast<size_t>(laser.beams));
   const b2Vec2 start(static_cast<float>(laser_pose.x), static_cast<float>(laser_pose.y));
   for (int k = 0; k < laser.beams; ++k) {
@@ -41,7 +42,7 @@ void Box2dLaserCaster::cast(const Pose2& laser_pose, const LaserGeometry& laser,
   }
 }
 
-GridLaserCaster::GridLaserCaster(const cv::Mat1b& occupied, double resolution, const Point2& origin)
+GridLaserCaster::GridLaserCaster(const cv::Mat1b& occupied, double resolution, const common::Point2& origin)
     : width_(occupied.cols), height_(occupied.rows), resolution_(resolution), origin_(origin) {
   cells_.resize(static_cast<size_t>(width_) * height_);
   for (int row = 0; row < height_; ++row) {
@@ -51,7 +52,7 @@ GridLaserCaster::GridLaserCaster(const cv::Mat1b& occupied, double resolution, c
   }
 }
 
-double GridLaserCaster::castRay(const Point2& start, const Point2& direction, double max_range) const {
+double GridLaserCaster::castRay(const common::Point2& start, const common::Point2& direction, double max_range) const {
   // Grid coordinates: cell (i, j) spans [i, i + 1) x [j, j + 1), j counted from the bottom.
   const double gx = (start.x() - origin_.x()) / resolution_, gy = (start.y() - origin_.y()) / resolution_;
   const double dx = direction.x(), dy = direction.y();
@@ -98,13 +99,15 @@ double GridLaserCaster::castRay(const Point2& start, const Point2& direction, do
   }
 }
 
-void GridLaserCaster::cast(const Pose2& laser_pose, const LaserGeometry& laser, std::vector<float>* ranges) const {
+void GridLaserCaster::cast(const common::Pose2& laser_pose, const common::LaserGeometry& laser,
+                           std::vector<float>* ranges) const {
   ranges->resize(static_cast<size_t>(laser.beams));
-  const Point2 start(laser_pose.x, laser_pose.y);
+  const common::Point2 start(laser_pose.x, laser_pose.y);
   for (int k = 0; k < laser.beams; ++k) {
     const double angle = laser_pose.yaw + laser.angle_min + k * laser.angle_increment;
-    (*ranges)[k] = static_cast<float>(castRay(start, Point2(std::cos(angle), std::sin(angle)), laser.max_range));
+    (*ranges)[k] =
+        static_cast<float>(castRay(start, common::Point2(std::cos(angle), std::sin(angle)), laser.max_range));
   }
 }
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::simulation

@@ -13,7 +13,7 @@
 #include "hidden_rooms/common/input_error.h"
 #include "hidden_rooms/common/range_scan.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::simulation {
 
 namespace {
 
@@ -21,17 +21,19 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr double kMinPieceSize = 0.01;  // metres: thinner or shorter pieces are dropped (Box2D welds vertices)
 constexpr int8_t kOccupiedThreshold = 65;  // map_saver's: cells at or above are solid
 
-bool finite(const Pose2& pose) { return std::isfinite(pose.x) && std::isfinite(pose.y) && std::isfinite(pose.yaw); }
+bool finite(const common::Pose2& pose) {
+  return std::isfinite(pose.x) && std::isfinite(pose.y) && std::isfinite(pose.yaw);
+}
 
 // A 4-vertex polygon with perpendicular sides, as centre line [start, end] and half width.
 struct Rectangle {
-  Point2 start, end;
+  common::Point2 start, end;
   double half_width = 0.0;
 };
 
-bool asRectangle(const Polygon& polygon, Rectangle* rectangle) {
+bool asRectangle(const common::Polygon& polygon, Rectangle* rectangle) {
   if (polygon.size() != 4) return false;
-  const Point2 side = polygon[1] - polygon[0], across = polygon[0] - polygon[3];
+  const common::Point2 side = polygon[1] - polygon[0], across = polygon[0] - polygon[3];
   if (side.norm() < 1e-9 || across.norm() < 1e-9) return false;
   if (std::abs(side.dot(across)) > 1e-6 * side.norm() * across.norm()) return false;
   if ((polygon[2] - polygon[1] + across).norm() > 1e-6 || (polygon[3] - polygon[2] + side).norm() > 1e-6) return false;
@@ -41,23 +43,23 @@ bool asRectangle(const Polygon& polygon, Rectangle* rectangle) {
   return true;
 }
 
-Polygon rectanglePolygon(const Point2& start, const Point2& end, double half_width) {
-  const Point2 along = (end - start).normalized();
-  const Point2 across(-along.y(), along.x());
+common::Polygon rectanglePolygon(const common::Point2& start, const common::Point2& end, double half_width) {
+  const common::Point2 along = (end - start).normalized();
+  const common::Point2 across(-along.y(), along.x());
   return {start + half_width * across, end + half_width * across, end - half_width * across,
           start - half_width * across};
 }
 
-bool usablePiece(const Polygon& polygon) {
-  if (polygon.size() < 3 || area(polygon) < kMinPieceSize * kMinPieceSize) return false;
+bool usablePiece(const common::Polygon& polygon) {
+  if (polygon.size() < 3 || common::area(polygon) < kMinPieceSize * kMinPieceSize) return false;
   for (size_t k = 0; k < polygon.size(); ++k)
     if ((polygon[(k + 1) % polygon.size()] - polygon[k]).norm() < kMinPieceSize) return false;
   return true;
 }
 
-b2PolygonShape toShape(const Polygon& polygon) {
+b2PolygonShape toShape(const common::Polygon& polygon) {
   std::vector<b2Vec2> points;
-  for (const Point2& p : polygon) points.emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()));
+  for (const common::Point2& p : polygon) points.emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()));
   b2PolygonShape shape;
   shape.Set(points.data(), static_cast<int32>(points.size()));
   return shape;
@@ -71,10 +73,10 @@ std::string lower(std::string text) {
 // Marks the cells of `grid` whose centres lie inside the convex polygon `polygon` (exact, so that the grid's
 // walls are neither fatter nor thinner than the polygons on average; OpenCV's fillPoly also takes cells the
 // outline merely touches).
-void fillConvexPolygon(OccupancyGrid* grid, const Polygon& polygon, int8_t value) {
+void fillConvexPolygon(common::OccupancyGrid* grid, const common::Polygon& polygon, int8_t value) {
   if (polygon.size() < 3) return;
   double y_low = polygon[0].y(), y_high = y_low;
-  for (const Point2& p : polygon) {
+  for (const common::Point2& p : polygon) {
     y_low = std::min(y_low, p.y());
     y_high = std::max(y_high, p.y());
   }
@@ -86,8 +88,8 @@ void fillConvexPolygon(OccupancyGrid* grid, const Polygon& polygon, int8_t value
     const double y = grid->origin.y() + (j + 0.5) * r;
     double x_low = std::numeric_limits<double>::infinity(), x_high = -x_low;
     for (size_t k = 0; k < polygon.size(); ++k) {
-      const Point2& a = polygon[k];
-      const Point2& b = polygon[(k + 1) % polygon.size()];
+      const common::Point2& a = polygon[k];
+      const common::Point2& b = polygon[(k + 1) % polygon.size()];
       if ((a.y() > y) == (b.y() > y) && a.y() != y) continue;
       if (a.y() == b.y()) {
         x_low = std::min({x_low, a.x(), b.x()});
@@ -142,23 +144,23 @@ int SimulationWorld::findDoor(const std::string& id_or_number) const {
   return -1;
 }
 
-std::vector<Polygon> mergeCollinearRectangles(const std::vector<Polygon>& rectangles) {
+std::vector<common::Polygon> mergeCollinearRectangles(const std::vector<common::Polygon>& rectangles) {
   struct Run {
-    Point2 direction, normal;
+    common::Point2 direction, normal;
     double offset = 0.0, half_width = 0.0;
     std::vector<std::pair<double, double>> intervals;
   };
   std::map<std::tuple<long long, long long, long long>, Run> runs;
-  std::vector<Polygon> merged;
-  for (const Polygon& polygon : rectangles) {
+  std::vector<common::Polygon> merged;
+  for (const common::Polygon& polygon : rectangles) {
     Rectangle rectangle;
     if (!asRectangle(polygon, &rectangle)) {
       merged.push_back(polygon);
       continue;
     }
-    Point2 direction = (rectangle.end - rectangle.start).normalized();
+    common::Point2 direction = (rectangle.end - rectangle.start).normalized();
     if (direction.y() < -1e-12 || (std::abs(direction.y()) <= 1e-12 && direction.x() < 0)) direction = -direction;
-    const Point2 normal(-direction.y(), direction.x());
+    const common::Point2 normal(-direction.y(), direction.x());
     const double angle = std::atan2(direction.y(), direction.x());
     const double offset = normal.dot(rectangle.start);
     const auto key = std::make_tuple(std::llround(angle * 1e6), std::llround(offset * 1e4),
@@ -189,44 +191,44 @@ std::vector<Polygon> mergeCollinearRectangles(const std::vector<Polygon>& rectan
   return merged;
 }
 
-SimulationWorld worldFromEnvironment(const Environment& environment, const std::set<int>& closed_door_indices,
-                                     const RenderOptions& options) {
+SimulationWorld worldFromEnvironment(const world::Environment& environment, const std::set<int>& closed_door_indices,
+                                     const world::RenderOptions& options) {
   for (int index : closed_door_indices)
     if (index < 0 || index >= static_cast<int>(environment.doors.size()))
-      throw InputError("simulation world", "closed door index " + std::to_string(index) + " does not exist");
+      throw common::InputError("simulation world", "closed door index " + std::to_string(index) + " does not exist");
   std::set<int> openable;
   for (size_t d = 0; d < environment.doors.size(); ++d)
     if (environment.doors[d].space_indices.size() >= 2) openable.insert(static_cast<int>(d));
-  const WallGeometry geometry = wallGeometry(environment, openable, options);
+  const world::WallGeometry geometry = world::wallGeometry(environment, openable, options);
 
   SimulationWorld world;
-  for (const Polygon& wall : mergeCollinearRectangles(geometry.walls))
+  for (const common::Polygon& wall : mergeCollinearRectangles(geometry.walls))
     if (usablePiece(wall)) world.walls.push_back(wall);
   for (size_t d = 0; d < environment.doors.size(); ++d) {
-    const Door& door = environment.doors[d];
+    const world::Door& door = environment.doors[d];
     SimulationWorld::DoorLeaf leaf;
     leaf.id = door.id;
     leaf.number = door.number;
-    for (const Polygon& piece : geometry.door_leaves[d])
+    for (const common::Polygon& piece : geometry.door_leaves[d])
       if (usablePiece(piece)) leaf.pieces.push_back(piece);
-    leaf.closed = openable.count(static_cast<int>(d)) == 0 || door.status == DoorStatus::kClosed ||
+    leaf.closed = openable.count(static_cast<int>(d)) == 0 || door.status == world::DoorStatus::kClosed ||
                   closed_door_indices.count(static_cast<int>(d)) > 0;
     world.doors.push_back(leaf);
   }
   // The ground truth with every door closed: the robot starts in a space, not in a doorway.
   std::set<int> all_doors;
   for (size_t d = 0; d < environment.doors.size(); ++d) all_doors.insert(static_cast<int>(d));
-  const RenderedEnvironment rendered = renderEnvironment(environment, all_doors, options);
+  const world::RenderedEnvironment rendered = world::renderEnvironment(environment, all_doors, options);
   world.free_space = rendered.map;
   world.space_labels = rendered.space_labels;
-  for (const Space& space : environment.spaces) world.space_kinds.push_back(space.label);
+  for (const world::Space& space : environment.spaces) world.space_kinds.push_back(space.label);
   return world;
 }
 
-SimulationWorld worldFromGrid(const OccupancyGrid& grid) {
-  if (grid.empty()) throw InputError("simulation world", "the map is empty");
-  if (cv::countNonZero(grid.cells == OccupancyGrid::kFree) == 0)
-    throw InputError("simulation world", "the map has no free cell to put the robot on");
+SimulationWorld worldFromGrid(const common::OccupancyGrid& grid) {
+  if (grid.empty()) throw common::InputError("simulation world", "the map is empty");
+  if (cv::countNonZero(grid.cells == common::OccupancyGrid::kFree) == 0)
+    throw common::InputError("simulation world", "the map has no free cell to put the robot on");
   SimulationWorld world;
   world.free_space = grid;
   world.source_resolution = grid.resolution;
@@ -237,7 +239,8 @@ SimulationWorld worldFromGrid(const OccupancyGrid& grid) {
     const double x0 = grid.origin.x() + c0 * grid.resolution, x1 = grid.origin.x() + c1 * grid.resolution;
     const double y0 = grid.origin.y() + (grid.height() - r1) * grid.resolution;
     const double y1 = grid.origin.y() + (grid.height() - r0) * grid.resolution;
-    world.walls.push_back({Point2(x0, y0), Point2(x1, y0), Point2(x1, y1), Point2(x0, y1)});
+    world.walls.push_back(
+        {common::Point2(x0, y0), common::Point2(x1, y0), common::Point2(x1, y1), common::Point2(x0, y1)});
   };
   for (int row = 0; row <= grid.height(); ++row) {
     std::set<std::pair<int, int>> runs;
@@ -271,12 +274,12 @@ const char* toString(LaserCasterKind kind) { return kind == LaserCasterKind::kBo
 LaserCasterKind laserCasterFromString(const std::string& name) {
   if (name == "box2d") return LaserCasterKind::kBox2d;
   if (name == "grid") return LaserCasterKind::kGrid;
-  throw InputError("simulation options", "laser caster must be 'box2d' or 'grid', not '" + name + "'");
+  throw common::InputError("simulation options", "laser caster must be 'box2d' or 'grid', not '" + name + "'");
 }
 
 void validate(const SimulationOptions& options) {
   auto require = [](bool ok, const std::string& problem) {
-    if (!ok) throw InputError("simulation options", problem);
+    if (!ok) throw common::InputError("simulation options", problem);
   };
   auto positive = [](double value) { return std::isfinite(value) && value > 0.0; };
   auto non_negative = [](double value) { return std::isfinite(value) && value >= 0.0; };
@@ -320,9 +323,9 @@ Simulation::Simulation(const SimulationWorld& world, const SimulationOptions& op
   physics_->SetAllowSleeping(false);
   b2BodyDef wall_def;
   b2Body* walls = physics_->CreateBody(&wall_def);
-  for (const Polygon& wall : world_.walls) {
+  for (const common::Polygon& wall : world_.walls) {
     if (!usablePiece(wall) || wall.size() > static_cast<size_t>(b2_maxPolygonVertices))
-      throw InputError("simulation world", "a wall is not a convex polygon of 3 to 8 usable vertices");
+      throw common::InputError("simulation world", "a wall is not a convex polygon of 3 to 8 usable vertices");
     const b2PolygonShape shape = toShape(wall);
     walls->CreateFixture(&shape, 0.0f);
   }
@@ -330,7 +333,7 @@ Simulation::Simulation(const SimulationWorld& world, const SimulationOptions& op
     b2Body* body = nullptr;
     if (!door.pieces.empty()) {
       body = physics_->CreateBody(&wall_def);
-      for (const Polygon& piece : door.pieces) {
+      for (const common::Polygon& piece : door.pieces) {
         const b2PolygonShape shape = toShape(piece);
         body->CreateFixture(&shape, 0.0f);
       }
@@ -343,9 +346,9 @@ Simulation::Simulation(const SimulationWorld& world, const SimulationOptions& op
     start_pose_ = *options_.start_pose;
   } else {
     // The free point farthest from anything else, in a corridor when the world has one.
-    const OccupancyGrid& free_space = world_.free_space;
-    if (free_space.empty()) throw InputError("simulation world", "no free space to start in: set a start pose");
-    const cv::Mat1b free_cells = free_space.cells == OccupancyGrid::kFree;
+    const common::OccupancyGrid& free_space = world_.free_space;
+    if (free_space.empty()) throw common::InputError("simulation world", "no free space to start in: set a start pose");
+    const cv::Mat1b free_cells = free_space.cells == common::OccupancyGrid::kFree;
     cv::Mat1b candidates = free_cells.clone();
     if (!world_.space_labels.empty()) {
       cv::Mat1b corridors = cv::Mat1b::zeros(free_cells.size());
@@ -354,7 +357,7 @@ Simulation::Simulation(const SimulationWorld& world, const SimulationOptions& op
       corridors &= free_cells;
       if (cv::countNonZero(corridors) > 0) candidates = corridors;
     }
-    if (cv::countNonZero(candidates) == 0) throw InputError("simulation world", "no free space to start in");
+    if (cv::countNonZero(candidates) == 0) throw common::InputError("simulation world", "no free space to start in");
     cv::Mat1b padded;
     cv::copyMakeBorder(free_cells, padded, 1, 1, 1, 1, cv::BORDER_CONSTANT, cv::Scalar(0));
     cv::Mat1f distance;
@@ -362,7 +365,7 @@ Simulation::Simulation(const SimulationWorld& world, const SimulationOptions& op
     cv::Point best;
     cv::minMaxLoc(distance(cv::Rect(1, 1, free_cells.cols, free_cells.rows)), nullptr, nullptr, nullptr, &best,
                   candidates);
-    const Point2 centre = free_space.cellCentre(best.x, best.y);
+    const common::Point2 centre = free_space.cellCentre(best.x, best.y);
     start_pose_ = {centre.x(), centre.y(), 0.0};
   }
 
@@ -384,36 +387,39 @@ Simulation::Simulation(const SimulationWorld& world, const SimulationOptions& op
   OverlapQuery query(&footprint, robot_->GetTransform(), robot_);
   physics_->QueryAABB(&query, box);
   if (query.overlaps())
-    throw InputError("simulation options", "the robot's footprint at the start pose (" + std::to_string(start_pose_.x) +
-                                               ", " + std::to_string(start_pose_.y) + ") overlaps a wall");
+    throw common::InputError("simulation options", "the robot's footprint at the start pose (" +
+                                                       std::to_string(start_pose_.x) + ", " +
+                                                       std::to_string(start_pose_.y) + ") overlaps a wall");
 
   box2d_caster_ = std::make_unique<Box2dLaserCaster>(physics_.get(), robot_);
   // The grid caster's walls: the source grid itself for grid worlds, else the walls rasterized.
   if (world_.source_resolution > 0.0) {
     wall_grid_ = world_.free_space;
-    wall_grid_.cells = cv::Mat_<int8_t>(world_.free_space.cells.size(), OccupancyGrid::kFree);
-    wall_grid_.cells.setTo(OccupancyGrid::kOccupied, world_.free_space.cells >= kOccupiedThreshold);
+    wall_grid_.cells = cv::Mat_<int8_t>(world_.free_space.cells.size(), common::OccupancyGrid::kFree);
+    wall_grid_.cells.setTo(common::OccupancyGrid::kOccupied, world_.free_space.cells >= kOccupiedThreshold);
   } else {
-    Point2 low = Point2::Constant(std::numeric_limits<double>::infinity()), high = -low;
-    auto extend = [&](const Polygon& polygon) {
-      for (const Point2& p : polygon) {
+    common::Point2 low = common::Point2::Constant(std::numeric_limits<double>::infinity()), high = -low;
+    auto extend = [&](const common::Polygon& polygon) {
+      for (const common::Point2& p : polygon) {
         low = low.cwiseMin(p);
         high = high.cwiseMax(p);
       }
     };
-    for (const Polygon& wall : world_.walls) extend(wall);
+    for (const common::Polygon& wall : world_.walls) extend(wall);
     for (const SimulationWorld::DoorLeaf& door : world_.doors)
-      for (const Polygon& piece : door.pieces) extend(piece);
-    if (low.x() > high.x()) low = high = Point2(start_pose_.x, start_pose_.y);
+      for (const common::Polygon& piece : door.pieces) extend(piece);
+    if (low.x() > high.x()) low = high = common::Point2(start_pose_.x, start_pose_.y);
     const double resolution = laser.grid_resolution;
     wall_grid_.resolution = resolution;
     wall_grid_.origin = ((low.array() - 1.0) / resolution).floor() * resolution;
     const Eigen::Array2d cells = ((high - wall_grid_.origin).array() + 1.0) / resolution;
     if (cells.x() * cells.y() > 4e8)
-      throw InputError("simulation options", "the grid caster's grid would exceed 4e8 cells: raise grid_resolution");
+      throw common::InputError("simulation options",
+                               "the grid caster's grid would exceed 4e8 cells: raise grid_resolution");
     wall_grid_.cells = cv::Mat_<int8_t>(static_cast<int>(std::ceil(cells.y())), static_cast<int>(std::ceil(cells.x())),
-                                        OccupancyGrid::kFree);
-    for (const Polygon& wall : world_.walls) fillConvexPolygon(&wall_grid_, wall, OccupancyGrid::kOccupied);
+                                        common::OccupancyGrid::kFree);
+    for (const common::Polygon& wall : world_.walls)
+      fillConvexPolygon(&wall_grid_, wall, common::OccupancyGrid::kOccupied);
   }
   rebuildGrid();
   drawOdometryError();
@@ -422,12 +428,14 @@ Simulation::Simulation(const SimulationWorld& world, const SimulationOptions& op
 Simulation::~Simulation() = default;
 
 void Simulation::rebuildGrid() {
-  OccupancyGrid grid = wall_grid_;
+  common::OccupancyGrid grid = wall_grid_;
   grid.cells = wall_grid_.cells.clone();
   for (const SimulationWorld::DoorLeaf& door : world_.doors)
     if (door.closed)
-      for (const Polygon& piece : door.pieces) fillConvexPolygon(&grid, piece, OccupancyGrid::kOccupied);
-  grid_caster_ = std::make_unique<GridLaserCaster>(grid.cells == OccupancyGrid::kOccupied, grid.resolution, grid.origin);
+      for (const common::Polygon& piece : door.pieces)
+        fillConvexPolygon(&grid, piece, common::OccupancyGrid::kOccupied);
+  grid_caster_ =
+      std::make_unique<GridLaserCaster>(grid.cells == common::OccupancyGrid::kOccupied, grid.resolution, grid.origin);
 }
 
 void Simulation::drawOdometryError() {
@@ -439,10 +447,10 @@ void Simulation::drawOdometryError() {
   }
 }
 
-void Simulation::setCommand(const VelocityCommand& command) {
+void Simulation::setCommand(const common::VelocityCommand& command) {
   if (!std::isfinite(command.linear) || !std::isfinite(command.angular))
-    throw InputError("cmd_vel", "velocity command is not finite (linear " + std::to_string(command.linear) +
-                                    ", angular " + std::to_string(command.angular) + ")");
+    throw common::InputError("cmd_vel", "velocity command is not finite (linear " + std::to_string(command.linear) +
+                                            ", angular " + std::to_string(command.angular) + ")");
   const RobotOptions& robot = options_.robot;
   target_.linear = std::clamp(command.linear, -robot.max_linear_velocity, robot.max_linear_velocity);
   target_.angular = std::clamp(command.angular, -robot.max_angular_velocity, robot.max_angular_velocity);
@@ -457,7 +465,7 @@ void Simulation::step() {
   commanded_.linear += std::clamp(target_.linear - commanded_.linear, -dv, dv);
   commanded_.angular += std::clamp(target_.angular - commanded_.angular, -dw, dw);
 
-  const Pose2 before = truePose();
+  const common::Pose2 before = truePose();
   const float angle = robot_->GetAngle();
   robot_->SetLinearVelocity(b2Vec2(static_cast<float>(commanded_.linear * std::cos(angle)),
                                    static_cast<float>(commanded_.linear * std::sin(angle))));
@@ -466,27 +474,28 @@ void Simulation::step() {
   ++steps_;
 
   // The motion of this step in the frame of the pose before it, measured, then integrated with the error.
-  const Pose2 after = truePose();
+  const common::Pose2 after = truePose();
   const double c = std::cos(before.yaw), s = std::sin(before.yaw);
   const double dx = after.x - before.x, dy = after.y - before.y;
-  const Pose2 motion{c * dx + s * dy, -s * dx + c * dy, wrapAngle(after.yaw - before.yaw)};
+  const common::Pose2 motion{c * dx + s * dy, -s * dx + c * dy, common::wrapAngle(after.yaw - before.yaw)};
   velocity_ = {motion.x / dt, motion.yaw / dt};
-  odometry_ = composePoses(odometry_, {motion.x * (1.0 + odometry_error_[0]), motion.y * (1.0 + odometry_error_[1]),
-                                  motion.yaw * (1.0 + odometry_error_[2])});
+  odometry_ =
+      common::composePoses(odometry_, {motion.x * (1.0 + odometry_error_[0]), motion.y * (1.0 + odometry_error_[1]),
+                                       motion.yaw * (1.0 + odometry_error_[2])});
 }
 
-VelocityCommand Simulation::odometryVelocity() const {
+common::VelocityCommand Simulation::odometryVelocity() const {
   return {velocity_.linear * (1.0 + odometry_error_[0]), velocity_.angular * (1.0 + odometry_error_[2])};
 }
 
-Pose2 Simulation::truePose() const {
+common::Pose2 Simulation::truePose() const {
   const b2Vec2 position = robot_->GetPosition();
-  return {position.x, position.y, wrapAngle(robot_->GetAngle())};
+  return {position.x, position.y, common::wrapAngle(robot_->GetAngle())};
 }
 
-Pose2 Simulation::laserPose() const { return composePoses(truePose(), options_.laser.mount); }
+common::Pose2 Simulation::laserPose() const { return common::composePoses(truePose(), options_.laser.mount); }
 
-Pose2 Simulation::odometryPose() const { return odometry_; }
+common::Pose2 Simulation::odometryPose() const { return odometry_; }
 
 const LaserCaster& Simulation::caster(LaserCasterKind kind) const {
   if (kind == LaserCasterKind::kBox2d) return *box2d_caster_;
@@ -521,9 +530,9 @@ void Simulation::reset() {
 
 void Simulation::setDoor(const std::string& id_or_number, bool open) {
   const int index = world_.findDoor(id_or_number);
-  if (index < 0) throw InputError("set_door", "no door '" + id_or_number + "' in this world");
+  if (index < 0) throw common::InputError("set_door", "no door '" + id_or_number + "' in this world");
   if (door_bodies_[index] == nullptr)
-    throw InputError("set_door", "door '" + id_or_number + "' leads outside (or has no leaf) and cannot open");
+    throw common::InputError("set_door", "door '" + id_or_number + "' leads outside (or has no leaf) and cannot open");
   SimulationWorld::DoorLeaf& door = world_.doors[index];
   if (door.closed == !open) return;
   door.closed = !open;
@@ -531,7 +540,7 @@ void Simulation::setDoor(const std::string& id_or_number, bool open) {
   rebuildGrid();
 }
 
-bool Simulation::solidNear(const Point2& point, double radius) const {
+bool Simulation::solidNear(const common::Point2& point, double radius) const {
   b2CircleShape circle;
   circle.m_radius = static_cast<float>(radius);
   b2Transform transform;
@@ -547,8 +556,8 @@ void compareCasters(const Simulation& simulation, double tolerance, CasterAgreem
   std::vector<float> exact, grid;
   simulation.scanWith(LaserCasterKind::kBox2d, &exact);
   simulation.scanWith(LaserCasterKind::kGrid, &grid);
-  const LaserGeometry& laser = simulation.laserGeometry();
-  const Pose2 pose = simulation.laserPose();
+  const common::LaserGeometry& laser = simulation.laserGeometry();
+  const common::Pose2 pose = simulation.laserPose();
   const float max_range = static_cast<float>(laser.max_range);
   for (size_t k = 0; k < exact.size(); ++k) {
     const float difference = std::abs(exact[k] - grid[k]);
@@ -560,7 +569,7 @@ void compareCasters(const Simulation& simulation, double tolerance, CasterAgreem
     }
     if (exact[k] >= max_range || grid[k] >= max_range) continue;
     const double angle = pose.yaw + laser.angle_min + static_cast<double>(k) * laser.angle_increment;
-    const Point2 hit(pose.x + grid[k] * std::cos(angle), pose.y + grid[k] * std::sin(angle));
+    const common::Point2 hit(pose.x + grid[k] * std::cos(angle), pose.y + grid[k] * std::sin(angle));
     if (simulation.solidNear(hit, 1.5 * simulation.gridResolution())) ++agreement->same_surface;
   }
 }
@@ -573,4 +582,4 @@ int Simulation::staticFixtureCount() const {
   return count;
 }
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::simulation

@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
-namespace hidden_rooms {
+namespace hidden_rooms::simulation {
 
-VelocityCommand WanderDriver::next(const std::vector<float>& ranges, const LaserGeometry& laser) {
+common::VelocityCommand WanderDriver::next(const std::vector<float>& ranges, const common::LaserGeometry& laser) {
   double ahead = laser.max_range, left = 0.0, right = 0.0;
   const int beams = std::min<int>(laser.beams, static_cast<int>(ranges.size()));
   for (int k = 0; k < beams; ++k) {
@@ -21,4 +21,4 @@ VelocityCommand WanderDriver::next(const std::vector<float>& ranges, const Laser
   return {std::min(0.6, 0.35 * ahead), std::clamp(2.0 * balance, -0.6, 0.6)};
 }
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::simulation

@@ -42,7 +42,7 @@ std::vector<int> parseNumbers(const std::string& text, const std::string& option
     } catch (const std::exception&) {
       used = 0;
     }
-    if (used != item.size() || value < 1) throw InputError(option, "'" + item + "' is not a positive integer");
+    if (used != item.size() || value < 1) throw common::InputError(option, "'" + item + "' is not a positive integer");
     numbers.push_back(value);
   }
   return numbers;
@@ -75,11 +75,11 @@ std::string jsonList(const std::vector<T>& values) {
   return text + "]";
 }
 
-void printInfo(const std::string& path, const Environment& environment) {
+void printInfo(const std::string& path, const world::Environment& environment) {
   std::vector<int> closable;
-  for (int index : closableDoors(environment)) closable.push_back(environment.doors[index].number);
+  for (int index : world::closableDoors(environment)) closable.push_back(environment.doors[index].number);
   double free_area = 0.0;
-  for (const Space& space : environment.spaces) free_area += area(space.outline);
+  for (const world::Space& space : environment.spaces) free_area += common::area(space.outline);
   std::cout << "{\"environment\": " << jsonString(path) << ", \"spaces\": " << environment.spaces.size()
             << ", \"doors\": " << environment.doors.size() << ", \"closable\": " << jsonList(closable)
             << ", \"floor_area\": " << jsonNumber(free_area) << "}" << std::endl;
@@ -87,7 +87,7 @@ void printInfo(const std::string& path, const Environment& environment) {
 
 int run(int argc, char** argv) {
   po::options_description options("Options");
-  RenderOptions render_options;
+  world::RenderOptions render_options;
   std::string environment_path, sequence_text, cases_text, methods_text, params_path, map_path, doors_in_map_path,
       write_dir;
   bool info = false;
@@ -108,68 +108,70 @@ int run(int argc, char** argv) {
   po::positional_options_description positional;
   positional.add("environment", 1);
   std::string methods_known;
-  for (const std::string& name : roomPredictorNames()) methods_known += (methods_known.empty() ? "" : ", ") + name;
+  for (const std::string& name : prediction::roomPredictorNames())
+    methods_known += (methods_known.empty() ? "" : ", ") + name;
   po::variables_map values;
-  if (!parseCommandLine(argc, argv,
-                        "Usage: batch_cases ENV.xml --sequence D1,D2,... --methods A,B [--cases K,...]\n"
-                        "                   [--params F.yaml] [--map MAP.yaml --doors-in-map DOORS.yaml]\n"
-                        "                   [--write-cases DIR]\n"
-                        "       batch_cases ENV.xml --info\n"
-                        "Methods: " + methods_known + "\n"
-                        "Case K closes the first K doors of the sequence, erases the rooms behind them, paints\n"
-                        "the doors as walls, runs every method and scores it against the true rooms; prints one\n"
-                        "JSON line per case: closed_doors, door_ids, hidden_percent, case_seconds and per method\n"
-                        "mean_iou, iou_total, seconds, not_placed, problem.",
-                        options, positional, &values))
-    return kExitOk;
+  const std::string usage =
+      "Usage: batch_cases ENV.xml --sequence D1,D2,... --methods A,B [--cases K,...]\n"
+      "                   [--params F.yaml] [--map MAP.yaml --doors-in-map DOORS.yaml]\n"
+      "                   [--write-cases DIR]\n"
+      "       batch_cases ENV.xml --info\n"
+      "Methods: " + methods_known + "\n"
+      "Case K closes the first K doors of the sequence, erases the rooms behind them, paints\n"
+      "the doors as walls, runs every method and scores it against the true rooms; prints one\n"
+      "JSON line per case: closed_doors, door_ids, hidden_percent, case_seconds and per method\n"
+      "mean_iou, iou_total, seconds, not_placed, problem.";
+  if (!common::parseCommandLine(argc, argv, usage, options, positional, &values))
+    return common::kExitOk;
 
-  const Environment environment = loadEnvironment(environment_path);
+  const world::Environment environment = world::loadEnvironment(environment_path);
   if (info) {
     printInfo(environment_path, environment);
-    return kExitOk;
+    return common::kExitOk;
   }
   if (map_path.empty() != doors_in_map_path.empty())
-    throw InputError("command line", "--map and --doors-in-map go together");
+    throw common::InputError("command line", "--map and --doors-in-map go together");
   const std::vector<int> sequence = parseNumbers(sequence_text, "--sequence");
-  if (sequence.empty()) throw InputError("--sequence", "no door to close");
+  if (sequence.empty()) throw common::InputError("--sequence", "no door to close");
   std::vector<int> cases = parseNumbers(cases_text, "--cases");
   if (cases.empty())
     for (size_t k = 1; k <= sequence.size(); ++k) cases.push_back(static_cast<int>(k));
   for (int k : cases)
     if (k > static_cast<int>(sequence.size()))
-      throw InputError("--cases", std::to_string(k) + " doors but the sequence has " +
-                                      std::to_string(sequence.size()));
-  std::vector<std::unique_ptr<RoomPredictor>> methods;
-  for (const std::string& name : splitList(methods_text)) methods.push_back(makeRoomPredictor(name));
-  if (methods.empty()) throw InputError("--methods", "no method given");
+      throw common::InputError("--cases",
+                               std::to_string(k) + " doors but the sequence has " + std::to_string(sequence.size()));
+  std::vector<std::unique_ptr<prediction::RoomPredictor>> methods;
+  for (const std::string& name : splitList(methods_text)) methods.push_back(prediction::makeRoomPredictor(name));
+  if (methods.empty()) throw common::InputError("--methods", "no method given");
   std::map<std::string, double> parameters;
-  if (!params_path.empty()) parameters = loadParameterFile(params_path);
-  for (const auto& method : methods) resolveParameters(*method, parameters);  // unknown names fail up front
-  std::optional<OccupancyGrid> complete_map;
-  DoorsFile doors_in_map;
+  if (!params_path.empty()) parameters = prediction::loadParameterFile(params_path);
+  for (const auto& method : methods) prediction::resolveParameters(*method, parameters);  // unknown names fail up front
+  std::optional<common::OccupancyGrid> complete_map;
+  common::DoorsFile doors_in_map;
   if (!map_path.empty()) {
-    complete_map = loadMap(map_path);
-    doors_in_map = loadDoors(doors_in_map_path);
+    complete_map = common::loadMap(map_path);
+    doors_in_map = common::loadDoors(doors_in_map_path);
   }
 
   for (int k : cases) {
     const std::vector<int> closed(sequence.begin(), sequence.begin() + k);
-    const BatchCase batch_case =
-        complete_map ? makeBatchCaseFromMap(environment, *complete_map, doors_in_map, closed, render_options.door_width)
-                     : makeBatchCase(environment, closed, render_options);
+    const evaluation::BatchCase batch_case =
+        complete_map ? evaluation::makeBatchCaseFromMap(environment, *complete_map, doors_in_map, closed,
+                                                        render_options.door_width)
+                     : evaluation::makeBatchCase(environment, closed, render_options);
     if (!write_dir.empty()) {
       const std::filesystem::path dir = std::filesystem::path(write_dir) / (std::to_string(k) + "_doors");
-      createOutputDirectory(dir.string());
-      saveMap(batch_case.input.map, (dir / "map").string());
-      saveDoors(batch_case.input.closed_doors, (dir / "doors.yaml").string());
-      saveLabelImage(batch_case.input.true_rooms, (dir / "true_rooms.png").string());
+      common::createOutputDirectory(dir.string());
+      common::saveMap(batch_case.input.map, (dir / "map").string());
+      common::saveDoors(batch_case.input.closed_doors, (dir / "doors.yaml").string());
+      common::saveLabelImage(batch_case.input.true_rooms, (dir / "true_rooms.png").string());
     }
     std::ostringstream line;
     line << "{\"closed_doors\": " << k << ", \"door_ids\": " << jsonList(closed)
          << ", \"hidden_percent\": " << jsonNumber(batch_case.hidden_percent)
          << ", \"case_seconds\": " << jsonNumber(batch_case.seconds) << ", \"methods\": {";
     for (size_t m = 0; m < methods.size(); ++m) {
-      const MethodOutcome outcome = runMethodOnCase(*methods[m], batch_case, parameters);
+      const evaluation::MethodOutcome outcome = evaluation::runMethodOnCase(*methods[m], batch_case, parameters);
       line << (m ? ", " : "") << jsonString(outcome.method)
            << ": {\"mean_iou\": " << jsonNumber(outcome.scores.mean_iou)
            << ", \"iou_total\": " << jsonNumber(outcome.scores.iou_total)
@@ -179,11 +181,11 @@ int run(int argc, char** argv) {
     line << "}}";
     std::cout << line.str() << std::endl;
   }
-  return kExitOk;
+  return common::kExitOk;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  return runTool("batch_cases", [&] { return run(argc, argv); });
+  return common::runTool("batch_cases", [&] { return run(argc, argv); });
 }

@@ -37,20 +37,21 @@ struct RunResult {
 };
 
 // `sim_seconds` of simulated time: physics every step, a noisy scan at `laser_rate` feeding the drive.
-RunResult runDrive(Simulation* simulation, double sim_seconds, double laser_rate, CasterAgreement* agreement,
-                   std::vector<float>* box2d_times, std::vector<float>* grid_times) {
+RunResult runDrive(simulation::Simulation* simulation, double sim_seconds, double laser_rate,
+                   simulation::CasterAgreement* agreement, std::vector<float>* box2d_times,
+                   std::vector<float>* grid_times) {
   RunResult result;
   const double dt = simulation->options().physics_step;
   const int laser_period = std::max(1, static_cast<int>(std::lround(1.0 / (laser_rate * dt))));
   const int steps = static_cast<int>(std::lround(sim_seconds / dt));
   std::vector<float> ranges;
-  WanderDriver driver;
+  simulation::WanderDriver driver;
   Clock::duration excluded{0};
   const Clock::time_point start = Clock::now();
-  Pose2 last = simulation->truePose();
+  common::Pose2 last = simulation->truePose();
   for (int k = 1; k <= steps; ++k) {
     simulation->step();
-    const Pose2 pose = simulation->truePose();
+    const common::Pose2 pose = simulation->truePose();
     result.distance += std::hypot(pose.x - last.x, pose.y - last.y);
     last = pose;
     if (k % laser_period != 0) continue;
@@ -60,13 +61,13 @@ RunResult runDrive(Simulation* simulation, double sim_seconds, double laser_rate
     if (agreement != nullptr && result.scans % 5 == 0) {  // measurements, not counted in the run's time
       const Clock::time_point t0 = Clock::now();
       std::vector<float> probe;
-      simulation->scanWith(LaserCasterKind::kBox2d, &probe);
+      simulation->scanWith(simulation::LaserCasterKind::kBox2d, &probe);
       const Clock::time_point t1 = Clock::now();
-      simulation->scanWith(LaserCasterKind::kGrid, &probe);
+      simulation->scanWith(simulation::LaserCasterKind::kGrid, &probe);
       const Clock::time_point t2 = Clock::now();
       box2d_times->push_back(static_cast<float>(seconds(t1 - t0) * 1e6));
       grid_times->push_back(static_cast<float>(seconds(t2 - t1) * 1e6));
-      compareCasters(*simulation, 0.05, agreement);
+      simulation::compareCasters(*simulation, 0.05, agreement);
       excluded += Clock::now() - t0;
     }
   }
@@ -78,7 +79,7 @@ int run(int argc, char** argv) {
   po::options_description options("Options");
   std::string world_path, closed_spec;
   double sim_seconds = 300.0, laser_rate = 10.0;
-  SimulationOptions simulation_options;
+  simulation::SimulationOptions simulation_options;
   int seed = 1;
   options.add_options()
       ("world", po::value(&world_path)->required(), "environment XML or map_server yaml")
@@ -92,37 +93,40 @@ int run(int argc, char** argv) {
   po::positional_options_description positional;
   positional.add("world", 1);
   po::variables_map values;
-  if (!parseCommandLine(argc, argv,
-                        "Usage: benchmark_simulation WORLD.xml|MAP.yaml [--sim-seconds S] [--grid-resolution R]\n"
-                        "Drives the simulated robot (scripted, reactive) with each laser caster and prints, as YAML,\n"
-                        "the real-time factor of the core, the casters' time per scan and their agreement.",
-                        options, positional, &values))
-    return kExitOk;
-  if (!(sim_seconds > 0.0) || !(laser_rate > 0.0)) throw InputError("command line", "durations and rates must be positive");
+  if (!common::parseCommandLine(
+          argc, argv,
+          "Usage: benchmark_simulation WORLD.xml|MAP.yaml [--sim-seconds S] [--grid-resolution R]\n"
+          "Drives the simulated robot (scripted, reactive) with each laser caster and prints, as YAML,\n"
+          "the real-time factor of the core, the casters' time per scan and their agreement.",
+          options, positional, &values))
+    return common::kExitOk;
+  if (!(sim_seconds > 0.0) || !(laser_rate > 0.0))
+    throw common::InputError("command line", "durations and rates must be positive");
   simulation_options.seed = static_cast<uint64_t>(std::max(seed, 0));
 
   const Clock::time_point load_start = Clock::now();
-  SimulationWorld world;
+  simulation::SimulationWorld world;
   const bool is_map = world_path.size() > 5 && world_path.substr(world_path.size() - 5) == ".yaml";
   if (is_map) {
-    world = worldFromGrid(loadMap(world_path));
+    world = simulation::worldFromGrid(common::loadMap(world_path));
   } else {
-    const Environment environment = loadEnvironment(world_path);
-    world = worldFromEnvironment(environment, parseDoorSelection(environment, closed_spec, "--closed"));
+    const world::Environment environment = world::loadEnvironment(world_path);
+    world =
+        simulation::worldFromEnvironment(environment, world::parseDoorSelection(environment, closed_spec, "--closed"));
   }
   const double load_seconds = seconds(Clock::now() - load_start);
 
   std::printf("world: %s\n", world_path.c_str());
   std::printf("load_seconds: %.3f\n", load_seconds);
-  CasterAgreement agreement;
+  simulation::CasterAgreement agreement;
   std::vector<float> box2d_times, grid_times;
-  for (LaserCasterKind kind : {LaserCasterKind::kBox2d, LaserCasterKind::kGrid}) {
-    SimulationOptions run_options = simulation_options;
+  for (simulation::LaserCasterKind kind : {simulation::LaserCasterKind::kBox2d, simulation::LaserCasterKind::kGrid}) {
+    simulation::SimulationOptions run_options = simulation_options;
     run_options.laser.caster = kind;
     const Clock::time_point build_start = Clock::now();
-    Simulation simulation(world, run_options);
+    simulation::Simulation simulation(world, run_options);
     const double build_seconds = seconds(Clock::now() - build_start);
-    const bool measure = kind == LaserCasterKind::kBox2d;
+    const bool measure = kind == simulation::LaserCasterKind::kBox2d;
     const RunResult result = runDrive(&simulation, sim_seconds, laser_rate, measure ? &agreement : nullptr,
                                       &box2d_times, &grid_times);
     if (measure)
@@ -139,11 +143,11 @@ int run(int argc, char** argv) {
               static_cast<double>(agreement.same_surface) / std::max(agreement.beams, 1),
               1.0 - static_cast<double>(agreement.within_tolerance + agreement.same_surface) / std::max(agreement.beams, 1),
               percentile(agreement.absolute_differences, 0.5), percentile(agreement.absolute_differences, 0.99));
-  return kExitOk;
+  return common::kExitOk;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  return runTool("benchmark_simulation", [&] { return run(argc, argv); });
+  return common::runTool("benchmark_simulation", [&] { return run(argc, argv); });
 }

@@ -13,7 +13,7 @@ namespace {
 int run(int argc, char** argv) {
   po::options_description options("Options");
   std::string map_path, rooms_path, out_path;
-  ExtrusionOptions extrusion;
+  map3d::ExtrusionOptions extrusion;
   options.add_options()
       ("map", po::value(&map_path)->required(), "map_server yaml")
       ("out", po::value(&out_path)->required(), "OctoMap to write: .ot (ColorOcTree, rooms coloured) or .bt")
@@ -23,23 +23,24 @@ int run(int argc, char** argv) {
   po::positional_options_description positional;
   positional.add("map", 1);
   po::variables_map values;
-  if (!parseCommandLine(argc, argv,
-                        "Usage: export_octomap MAP.yaml --out F.ot|F.bt [--rooms rooms.yaml] [--height 2.5]\n"
-                        "Extrudes the map into 3D: occupied cells become walls from the floor (z = 0) to --height,\n"
-                        "free cells free space, unknown cells stay unknown. A .ot file (ColorOcTree) colours the\n"
-                        "predicted rooms of --rooms as the overlays do and the rest grey; a .bt file is occupancy only.",
-                        options, positional, &values))
-    return kExitOk;
-  const OccupancyGrid map = loadMap(map_path);
-  const cv::Mat1w labels = rooms_path.empty() ? cv::Mat1w() : roomLabelsFromYaml(rooms_path, map);
-  exportOctomap(map, labels, extrusion, out_path);
+  if (!common::parseCommandLine(
+          argc, argv,
+          "Usage: export_octomap MAP.yaml --out F.ot|F.bt [--rooms rooms.yaml] [--height 2.5]\n"
+          "Extrudes the map into 3D: occupied cells become walls from the floor (z = 0) to --height,\n"
+          "free cells free space, unknown cells stay unknown. A .ot file (ColorOcTree) colours the\n"
+          "predicted rooms of --rooms as the overlays do and the rest grey; a .bt file is occupancy only.",
+          options, positional, &values))
+    return common::kExitOk;
+  const common::OccupancyGrid map = common::loadMap(map_path);
+  const cv::Mat1w labels = rooms_path.empty() ? cv::Mat1w() : map3d::roomLabelsFromYaml(rooms_path, map);
+  map3d::exportOctomap(map, labels, extrusion, out_path);
   std::cout << "export_octomap: " << map.width() << "x" << map.height() << " map, " << extrusion.height
             << " m high -> " << out_path << std::endl;
-  return kExitOk;
+  return common::kExitOk;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  return runTool("export_octomap", [&] { return run(argc, argv); });
+  return common::runTool("export_octomap", [&] { return run(argc, argv); });
 }

@@ -24,29 +24,30 @@ int run(int argc, char** argv) {
                                                   "large (>= 16)")
       ("out", po::value(&out_path)->required(), "output environment XML");
   po::variables_map values;
-  if (!hidden_rooms::parseCommandLine(argc, argv,
-                                      "Usage: generate_world --seed S --size small|medium|large --out F.xml\n"
-                                      "Writes a generated floor (corridors with rooms along them) as environment "
-                                      "XML.",
-                                      options, po::positional_options_description(), &values))
-    return hidden_rooms::kExitOk;
+  if (!hidden_rooms::common::parseCommandLine(
+          argc, argv,
+          "Usage: generate_world --seed S --size small|medium|large --out F.xml\n"
+          "Writes a generated floor (corridors with rooms along them) as environment "
+          "XML.",
+          options, po::positional_options_description(), &values))
+    return hidden_rooms::common::kExitOk;
   if (seed < 0 || seed > static_cast<long long>(std::numeric_limits<std::uint32_t>::max()))
-    throw hidden_rooms::InputError("command line", "--seed " + std::to_string(seed) + " is out of range (0 .. " +
-                                                       std::to_string(std::numeric_limits<std::uint32_t>::max()) +
-                                                       ")");
-  const hidden_rooms::SizeClass size_class = hidden_rooms::parseSizeClass(size_text);
+    throw hidden_rooms::common::InputError("command line",
+                                           "--seed " + std::to_string(seed) + " is out of range (0 .. " +
+                                               std::to_string(std::numeric_limits<std::uint32_t>::max()) + ")");
+  const hidden_rooms::world::SizeClass size_class = hidden_rooms::world::parseSizeClass(size_text);
 
-  const hidden_rooms::Environment environment =
-      hidden_rooms::generateWorld(static_cast<std::uint32_t>(seed), size_class);
-  hidden_rooms::saveEnvironment(environment, out_path);
-  std::cout << out_path << ": " << hidden_rooms::toString(size_class) << " world '" << environment.name << "', "
+  const hidden_rooms::world::Environment environment =
+      hidden_rooms::world::generateWorld(static_cast<std::uint32_t>(seed), size_class);
+  hidden_rooms::world::saveEnvironment(environment, out_path);
+  std::cout << out_path << ": " << hidden_rooms::world::toString(size_class) << " world '" << environment.name << "', "
             << environment.spaces.size() << " spaces, " << environment.doors.size() << " doors ("
-            << hidden_rooms::closableDoors(environment).size() << " closable)" << std::endl;
-  return hidden_rooms::kExitOk;
+            << hidden_rooms::world::closableDoors(environment).size() << " closable)" << std::endl;
+  return hidden_rooms::common::kExitOk;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  return hidden_rooms::runTool("generate_world", [&] { return run(argc, argv); });
+  return hidden_rooms::common::runTool("generate_world", [&] { return run(argc, argv); });
 }

@@ -26,38 +26,39 @@ int run(int argc, char** argv) {
       ("gt-rooms", po::value(&gt_path), "true rooms: label image, k = room behind the k-th door")
       ("debug-dir", po::value(&debug_dir), "folder for per-stage debug images");
   std::string methods;
-  for (const std::string& name : roomPredictorNames()) methods += (methods.empty() ? "" : ", ") + name;
+  for (const std::string& name : prediction::roomPredictorNames()) methods += (methods.empty() ? "" : ", ") + name;
   po::variables_map values;
-  if (!parseCommandLine(argc, argv,
-                        "Usage: predict_rooms_offline --map MAP.yaml --doors DOORS.yaml --method NAME --out DIR\n"
-                        "       [--params FILE.yaml] [--gt-rooms LABELS.png] [--debug-dir D]\n"
-                        "Methods: " + methods + "\n"
-                        "Writes DIR/rooms.png (label k = room of the k-th door), DIR/rooms.yaml, DIR/map.yaml +\n"
-                        "DIR/map.pgm (the map completed with the rooms), DIR/overlay.png (a picture: predicted rooms\n"
-                        "tinted, true rooms outlined in green) and, with --gt-rooms, DIR/metrics.yaml.",
-                        options, po::positional_options_description(), &values))
-    return kExitOk;
+  const std::string usage =
+      "Usage: predict_rooms_offline --map MAP.yaml --doors DOORS.yaml --method NAME --out DIR\n"
+      "       [--params FILE.yaml] [--gt-rooms LABELS.png] [--debug-dir D]\n"
+      "Methods: " + methods + "\n"
+      "Writes DIR/rooms.png (label k = room of the k-th door), DIR/rooms.yaml, DIR/map.yaml +\n"
+      "DIR/map.pgm (the map completed with the rooms), DIR/overlay.png (a picture: predicted rooms\n"
+      "tinted, true rooms outlined in green) and, with --gt-rooms, DIR/metrics.yaml.";
+  if (!common::parseCommandLine(argc, argv, usage, options, po::positional_options_description(), &values))
+    return common::kExitOk;
 
   // Read and check everything before writing anything.
-  const std::unique_ptr<RoomPredictor> predictor = makeRoomPredictor(method);
-  PredictionRequest request;
-  request.map = loadMap(map_path);
-  request.doors = loadDoors(doors_path);
-  if (!params_path.empty()) request.parameters = loadParameterFile(params_path);
+  const std::unique_ptr<prediction::RoomPredictor> predictor = prediction::makeRoomPredictor(method);
+  prediction::PredictionRequest request;
+  request.map = common::loadMap(map_path);
+  request.doors = common::loadDoors(doors_path);
+  if (!params_path.empty()) request.parameters = prediction::loadParameterFile(params_path);
   request.debug_dir = debug_dir;
   cv::Mat truth;
-  if (!gt_path.empty()) truth = loadTrueRooms(gt_path, request.map);
-  if (!debug_dir.empty()) createOutputDirectory(debug_dir);
+  if (!gt_path.empty()) truth = evaluation::loadTrueRooms(gt_path, request.map);
+  if (!debug_dir.empty()) common::createOutputDirectory(debug_dir);
 
-  const PredictionResult result = predictor->predict(request);
+  const prediction::PredictionResult result = predictor->predict(request);
 
-  const PredictionOutputs outputs = writePredictionOutputs(request, result, method, out_dir, truth);
-  printPredictionSummary(std::cout, request, result, method, out_dir, outputs);
-  return kExitOk;
+  const evaluation::PredictionOutputs outputs =
+      evaluation::writePredictionOutputs(request, result, method, out_dir, truth);
+  evaluation::printPredictionSummary(std::cout, request, result, method, out_dir, outputs);
+  return common::kExitOk;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  return runTool("predict_rooms_offline", [&] { return run(argc, argv); });
+  return common::runTool("predict_rooms_offline", [&] { return run(argc, argv); });
 }

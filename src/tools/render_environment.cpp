@@ -21,7 +21,7 @@ namespace {
 
 int run(int argc, char** argv) {
   po::options_description options("Options");
-  RenderOptions render_options;
+  world::RenderOptions render_options;
   std::string environment_path, out_dir, closed_spec;
   double wall_thickness = 0.0;
   bool hide_rooms = false;
@@ -40,40 +40,41 @@ int run(int argc, char** argv) {
   po::positional_options_description positional;
   positional.add("environment", 1);
   po::variables_map values;
-  if (!parseCommandLine(argc, argv,
-                        "Usage: render_environment ENV.xml --out DIR [--resolution R] [--closed ID,...|closable|all]\n"
-                        "                          [--hide-closed-rooms]\n"
-                        "Writes DIR/map.yaml, DIR/map.pgm, DIR/spaces.png (label = 1 + space index in XML order),\n"
-                        "DIR/doors.yaml (the closed doors, map frame) and DIR/preview.png; with --hide-closed-rooms\n"
-                        "also DIR/true_rooms.png (label k = the room behind the k-th closed door).",
-                        options, positional, &values))
-    return kExitOk;
+  if (!common::parseCommandLine(
+          argc, argv,
+          "Usage: render_environment ENV.xml --out DIR [--resolution R] [--closed ID,...|closable|all]\n"
+          "                          [--hide-closed-rooms]\n"
+          "Writes DIR/map.yaml, DIR/map.pgm, DIR/spaces.png (label = 1 + space index in XML order),\n"
+          "DIR/doors.yaml (the closed doors, map frame) and DIR/preview.png; with --hide-closed-rooms\n"
+          "also DIR/true_rooms.png (label k = the room behind the k-th closed door).",
+          options, positional, &values))
+    return common::kExitOk;
   if (values.count("wall-thickness")) render_options.wall_thickness = wall_thickness;
 
-  const Environment environment = loadEnvironment(environment_path);
-  const std::set<int> closed = parseDoorSelection(environment, closed_spec, "--closed");
-  const RenderedEnvironment rendered = renderEnvironment(environment, closed, render_options);
+  const world::Environment environment = world::loadEnvironment(environment_path);
+  const std::set<int> closed = world::parseDoorSelection(environment, closed_spec, "--closed");
+  const world::RenderedEnvironment rendered = world::renderEnvironment(environment, closed, render_options);
 
-  std::optional<HiddenRoomsCase> hidden;
-  if (hide_rooms) hidden = hideClosedRooms(environment, rendered);
+  std::optional<world::HiddenRoomsCase> hidden;
+  if (hide_rooms) hidden = world::hideClosedRooms(environment, rendered);
 
-  createOutputDirectory(out_dir);
+  common::createOutputDirectory(out_dir);
   const std::filesystem::path out(out_dir);
-  saveMap(hidden ? hidden->map : rendered.map, (out / "map").string());
-  saveLabelImage(rendered.space_labels, (out / "spaces.png").string());
-  saveDoors(rendered.closed_doors, (out / "doors.yaml").string());
-  if (hidden) saveLabelImage(hidden->true_rooms, (out / "true_rooms.png").string());
-  writeImage((out / "preview.png").string(), renderPreview(environment, rendered));
+  common::saveMap(hidden ? hidden->map : rendered.map, (out / "map").string());
+  common::saveLabelImage(rendered.space_labels, (out / "spaces.png").string());
+  common::saveDoors(rendered.closed_doors, (out / "doors.yaml").string());
+  if (hidden) common::saveLabelImage(hidden->true_rooms, (out / "true_rooms.png").string());
+  common::writeImage((out / "preview.png").string(), world::renderPreview(environment, rendered));
 
   std::cout << environment_path << ": " << environment.spaces.size() << " spaces, " << environment.doors.size()
-            << " doors (" << closableDoors(environment).size() << " closable), "
+            << " doors (" << world::closableDoors(environment).size() << " closable), "
             << rendered.closed_doors.doors.size() << " closed; map " << rendered.map.width() << "x"
             << rendered.map.height() << " cells at " << rendered.map.resolution << " m -> " << out_dir << std::endl;
-  return kExitOk;
+  return common::kExitOk;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  return runTool("render_environment", [&] { return run(argc, argv); });
+  return common::runTool("render_environment", [&] { return run(argc, argv); });
 }

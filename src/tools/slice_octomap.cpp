@@ -13,7 +13,7 @@ namespace {
 int run(int argc, char** argv) {
   po::options_description options("Options");
   std::string octomap_path, out_path;
-  SliceOptions slice;
+  map3d::SliceOptions slice;
   options.add_options()
       ("octomap", po::value(&octomap_path)->required(), "OctoMap file (.bt or .ot)")
       ("out", po::value(&out_path)->required(), "map to write (map_server yaml; the pgm goes beside it)")
@@ -23,23 +23,24 @@ int run(int argc, char** argv) {
   po::positional_options_description positional;
   positional.add("octomap", 1);
   po::variables_map values;
-  if (!parseCommandLine(argc, argv,
-                        "Usage: slice_octomap F.bt|F.ot --out MAP.yaml [--z-min 0.1] [--z-max 2.0] [--resolution R]\n"
-                        "A cell is occupied when any voxel of the band above it is occupied, free when some voxel of\n"
-                        "the band is observed free and none is occupied, unknown otherwise.",
-                        options, positional, &values))
-    return kExitOk;
+  if (!common::parseCommandLine(
+          argc, argv,
+          "Usage: slice_octomap F.bt|F.ot --out MAP.yaml [--z-min 0.1] [--z-max 2.0] [--resolution R]\n"
+          "A cell is occupied when any voxel of the band above it is occupied, free when some voxel of\n"
+          "the band is observed free and none is occupied, unknown otherwise.",
+          options, positional, &values))
+    return common::kExitOk;
   std::string prefix = out_path;
   if (prefix.size() > 5 && prefix.substr(prefix.size() - 5) == ".yaml") prefix.resize(prefix.size() - 5);
-  const OccupancyGrid map = sliceOctomap(octomap_path, slice);
-  const std::string written = saveMap(map, prefix);
+  const common::OccupancyGrid map = map3d::sliceOctomap(octomap_path, slice);
+  const std::string written = common::saveMap(map, prefix);
   std::cout << "slice_octomap: z in [" << slice.z_min << ", " << slice.z_max << "] m -> " << map.width() << "x"
             << map.height() << " cells at " << map.resolution << " m -> " << written << std::endl;
-  return kExitOk;
+  return common::kExitOk;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  return runTool("slice_octomap", [&] { return run(argc, argv); });
+  return common::runTool("slice_octomap", [&] { return run(argc, argv); });
 }

@@ -27,7 +27,7 @@ namespace {
 constexpr double kLocalFitRadius = 5.0;  // metres: poses near a door that place the world for its error
 
 // Distance (metres) of every cell of `map` to its nearest occupied cell (a large value when there is none).
-cv::Mat1f distanceToOccupied(const OccupancyGrid& map) {
+cv::Mat1f distanceToOccupied(const common::OccupancyGrid& map) {
   cv::Mat1b not_occupied(map.height(), map.width());
   for (int row = 0; row < map.height(); ++row)
     for (int col = 0; col < map.width(); ++col) not_occupied(row, col) = map.cells(row, col) >= 65 ? 0 : 255;
@@ -40,7 +40,7 @@ int run(int argc, char** argv) {
   po::options_description options("Options");
   std::string environment_path, closed_spec, truth_path, estimate_path, map_path, out_dir;
   double door_width = 0.9, robot_radius = 0.25;
-  RenderOptions render_options;
+  world::RenderOptions render_options;
   options.add_options()
       ("environment", po::value(&environment_path)->required(), "environment XML the robot explored")
       ("closed", po::value(&closed_spec)->default_value(""),
@@ -57,57 +57,62 @@ int run(int argc, char** argv) {
       ("wall-thickness", po::value<double>(), "wall thickness as simulated, metres (default: the world's)");
   po::positional_options_description positional;
   po::variables_map values;
-  if (!parseCommandLine(argc, argv,
-                        "Usage: translate_doors --environment ENV.xml --closed SPEC --truth GT.log --estimate MAP.log\n"
-                        "                       --out DIR [--map MAP.yaml]\n"
-                        "Writes DIR/doors.yaml: the closed doors in the map frame, each carried over from the world\n"
-                        "by the robot pose closest to it (docs/method.md#closed-doors-in-the-map). With --map also\n"
-                        "DIR/true_rooms.png (label k = the room behind the k-th door, in the map's grid) and\n"
-                        "DIR/exploration.yaml: coverage of the reachable free area, map quality, path length and each\n"
-                        "door's translation error (against the world placed by the poses within 5 m of the door, and\n"
-                        "by the whole run).",
-                        options, positional, &values))
-    return kExitOk;
-  if (!(door_width > 0.0)) throw InputError("--door-width", "must be positive");
-  if (!(robot_radius >= 0.0)) throw InputError("--robot-radius", "must be zero or positive");
+  if (!common::parseCommandLine(
+          argc, argv,
+          "Usage: translate_doors --environment ENV.xml --closed SPEC --truth GT.log --estimate MAP.log\n"
+          "                       --out DIR [--map MAP.yaml]\n"
+          "Writes DIR/doors.yaml: the closed doors in the map frame, each carried over from the world\n"
+          "by the robot pose closest to it (docs/method.md#closed-doors-in-the-map). With --map also\n"
+          "DIR/true_rooms.png (label k = the room behind the k-th door, in the map's grid) and\n"
+          "DIR/exploration.yaml: coverage of the reachable free area, map quality, path length and each\n"
+          "door's translation error (against the world placed by the poses within 5 m of the door, and\n"
+          "by the whole run).",
+          options, positional, &values))
+    return common::kExitOk;
+  if (!(door_width > 0.0)) throw common::InputError("--door-width", "must be positive");
+  if (!(robot_radius >= 0.0)) throw common::InputError("--robot-radius", "must be zero or positive");
   if (values.count("wall-thickness")) render_options.wall_thickness = values["wall-thickness"].as<double>();
   render_options.door_width = door_width;
 
-  const Environment environment = loadEnvironment(environment_path);
-  const std::set<int> closed = parseDoorSelection(environment, closed_spec, "--closed");
-  const RenderedEnvironment rendered = renderEnvironment(environment, closed, render_options);
+  const world::Environment environment = world::loadEnvironment(environment_path);
+  const std::set<int> closed = world::parseDoorSelection(environment, closed_spec, "--closed");
+  const world::RenderedEnvironment rendered = world::renderEnvironment(environment, closed, render_options);
   // The closed doors that hide a room (closable): a closed door of a room with another door hides nothing.
   std::vector<int> door_indices;
-  for (const MapDoor& door : rendered.closed_doors.doors) {
+  for (const common::MapDoor& door : rendered.closed_doors.doors) {
     const int index = environment.findDoor(std::to_string(door.id));
-    if (roomBehindDoor(environment, index) >= 0)
+    if (world::roomBehindDoor(environment, index) >= 0)
       door_indices.push_back(index);
     else
       std::cout << "translate_doors: door " << door.id << " is closed but hides no room (its other side has more "
                 << "doors); not written" << std::endl;
   }
-  const PoseLog truth = loadPoseLog(truth_path);
-  const PoseLog estimate = loadPoseLog(estimate_path);
+  const common::PoseLog truth = common::loadPoseLog(truth_path);
+  const common::PoseLog estimate = common::loadPoseLog(estimate_path);
 
-  const DoorsFile doors = translateDoors(environment, door_indices, truth.poses, estimate.poses, door_width);
-  createOutputDirectory(out_dir);
+  const common::DoorsFile doors =
+      evaluation::translateDoors(environment, door_indices, truth.poses, estimate.poses, door_width);
+  common::createOutputDirectory(out_dir);
   const std::filesystem::path out(out_dir);
-  saveDoors(doors, (out / "doors.yaml").string());
+  common::saveDoors(doors, (out / "doors.yaml").string());
   std::cout << "translate_doors: " << doors.doors.size() << " closed doors -> " << (out / "doors.yaml").string()
             << std::endl;
-  if (map_path.empty()) return kExitOk;
+  if (map_path.empty()) return common::kExitOk;
 
   // Scoring: the world placed in the map frame by the least-squares fit of the two trajectories.
-  const OccupancyGrid map = loadMap(map_path);
-  const Pose2 world_from_map = fitWorldFromMap(truth.poses, estimate.poses);
-  const Pose2 start = truth.poses.front().pose;
-  const cv::Mat1b reachable = reachableFreeArea(rendered.map, Point2(start.x, start.y), robot_radius);
-  const MapQuality quality = evaluateMap(map, world_from_map, rendered.map, reachable);
-  const MapQuality all_free = evaluateMap(map, world_from_map, rendered.map, reachableFreeArea(rendered.map, Point2(start.x, start.y)));
-  const cv::Mat1w true_rooms = trueRoomsInMap(environment, door_indices, spaceLabelsInMap(rendered, map, world_from_map));
-  saveLabelImage(true_rooms, (out / "true_rooms.png").string());
+  const common::OccupancyGrid map = common::loadMap(map_path);
+  const common::Pose2 world_from_map = evaluation::fitWorldFromMap(truth.poses, estimate.poses);
+  const common::Pose2 start = truth.poses.front().pose;
+  const cv::Mat1b reachable =
+      evaluation::reachableFreeArea(rendered.map, common::Point2(start.x, start.y), robot_radius);
+  const evaluation::MapQuality quality = evaluation::evaluateMap(map, world_from_map, rendered.map, reachable);
+  const evaluation::MapQuality all_free = evaluation::evaluateMap(
+      map, world_from_map, rendered.map, evaluation::reachableFreeArea(rendered.map, common::Point2(start.x, start.y)));
+  const cv::Mat1w true_rooms = evaluation::trueRoomsInMap(environment, door_indices,
+                                                          evaluation::spaceLabelsInMap(rendered, map, world_from_map));
+  common::saveLabelImage(true_rooms, (out / "true_rooms.png").string());
 
-  const auto coverageOf = [](const MapQuality& q) {
+  const auto coverageOf = [](const evaluation::MapQuality& q) {
     return q.true_free_cells ? double(q.intersection_cells) / double(q.true_free_cells) : 0.0;
   };
   const double coverage = coverageOf(quality);
@@ -127,12 +132,14 @@ int run(int argc, char** argv) {
          << "doors:\n";
   double worst_error = 0.0;
   for (size_t k = 0; k < doors.doors.size(); ++k) {
-    const Door& door = environment.doors[door_indices[k]];
+    const world::Door& door = environment.doors[door_indices[k]];
     // Where the map shows the door: the world placed by the poses within kLocalFitRadius of it.
-    const Point2 fitted = transformPoint(
-        invertPose(fitWorldFromMapNear(truth.poses, estimate.poses, door.centre, kLocalFitRadius)), door.centre);
+    const common::Point2 fitted = common::transformPoint(
+        common::invertPose(evaluation::fitWorldFromMapNear(truth.poses, estimate.poses, door.centre, kLocalFitRadius)),
+        door.centre);
     const double error = (doors.doors[k].position - fitted).norm();
-    const double global_error = (doors.doors[k].position - transformPoint(invertPose(world_from_map), door.centre)).norm();
+    const double global_error =
+        (doors.doors[k].position - common::transformPoint(common::invertPose(world_from_map), door.centre)).norm();
     int col = 0, row = 0;
     const double to_wall =
         map.cellOf(doors.doors[k].position, &col, &row) ? wall_distance(row, col) : std::numeric_limits<double>::infinity();
@@ -142,16 +149,16 @@ int run(int argc, char** argv) {
            << "], error: " << error << ", global_error: " << global_error << ", to_mapped_wall: " << (std::isfinite(to_wall) ? std::to_string(to_wall) : std::string(".inf"))
            << "}\n";
   }
-  writeTextAtomically((out / "exploration.yaml").string(), report.str(), "exploration report");
+  common::writeTextAtomically((out / "exploration.yaml").string(), report.str(), "exploration report");
   std::cout << "translate_doors: coverage " << std::fixed << std::setprecision(3)
             << coverage << " (all free cells " << coverageOf(all_free) << ")"
             << ", free IoU " << all_free.free_iou << ", worst door error " << worst_error << " m -> "
             << (out / "exploration.yaml").string() << std::endl;
-  return kExitOk;
+  return common::kExitOk;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  return runTool("translate_doors", [&] { return run(argc, argv); });
+  return common::runTool("translate_doors", [&] { return run(argc, argv); });
 }

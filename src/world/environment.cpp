@@ -14,7 +14,7 @@
 #include "hidden_rooms/common/file_io.h"
 #include "hidden_rooms/common/input_error.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::world {
 
 namespace {
 
@@ -31,8 +31,8 @@ std::string lineOf(const XMLElement* element) { return "line " + std::to_string(
 const XMLElement* requireChild(const XMLElement* parent, const char* name, const std::string& source) {
   const XMLElement* child = parent->FirstChildElement(name);
   if (child == nullptr)
-    throw InputError(source, "<" + std::string(parent->Name()) + "> at " + lineOf(parent) + " has no <" + name +
-                                 "> element");
+    throw common::InputError(
+        source, "<" + std::string(parent->Name()) + "> at " + lineOf(parent) + " has no <" + name + "> element");
   return child;
 }
 
@@ -50,15 +50,15 @@ double parseNumber(const std::string& text, const XMLElement* where, const std::
   char* end = nullptr;
   const double value = std::strtod(text.c_str(), &end);
   if (text.empty() || end == text.c_str() || *end != '\0' || !std::isfinite(value))
-    throw InputError(source, what + " at " + lineOf(where) + " is not a finite number: '" + text + "'");
+    throw common::InputError(source, what + " at " + lineOf(where) + " is not a finite number: '" + text + "'");
   return value;
 }
 
 // Reads <point x= y=> as XML pixels.
-Point2 readPoint(const XMLElement* point, const std::string& source) {
+common::Point2 readPoint(const XMLElement* point, const std::string& source) {
   const char* x = point->Attribute("x");
   const char* y = point->Attribute("y");
-  if (x == nullptr || y == nullptr) throw InputError(source, "<point> at " + lineOf(point) + " lacks x or y");
+  if (x == nullptr || y == nullptr) throw common::InputError(source, "<point> at " + lineOf(point) + " lacks x or y");
   return {parseNumber(x, point, "point x", source), parseNumber(y, point, "point y", source)};
 }
 
@@ -67,42 +67,42 @@ double unitInMetres(const std::string& unit, const XMLElement* where, const std:
   if (unit == "dm") return 0.1;
   if (unit == "cm" || unit.empty()) return 0.01;
   if (unit == "mm") return 0.001;
-  throw InputError(source, "unknown length unit '" + unit + "' at " + lineOf(where) + " (m, dm, cm, mm)");
+  throw common::InputError(source, "unknown length unit '" + unit + "' at " + lineOf(where) + " (m, dm, cm, mm)");
 }
 
 double readScale(const XMLElement* building, const std::string& source) {
   const XMLElement* scale = building->FirstChildElement("scale");
-  if (scale == nullptr) throw InputError(source, "missing <scale> element (pixels to metres)");
+  if (scale == nullptr) throw common::InputError(source, "missing <scale> element (pixels to metres)");
   const XMLElement* represented = requireChild(scale, "represented_distance", source);
   const XMLElement* real = requireChild(scale, "real_distance", source);
   const double pixels = parseNumber(childText(represented, "value"), represented, "represented_distance", source);
   const double distance = parseNumber(childText(real, "value"), real, "real_distance", source) *
                           unitInMetres(childText(real, "um"), real, source);
   if (pixels <= 0.0 || distance <= 0.0)
-    throw InputError(source, "<scale> at " + lineOf(scale) + " must have positive distances");
+    throw common::InputError(source, "<scale> at " + lineOf(scale) + " must have positive distances");
   return distance / pixels;
 }
 
 SegmentClass parseSegmentClass(const std::string& text, const XMLElement* where, const std::string& source) {
   if (text == "WALL") return SegmentClass::kWall;
   if (text == "PORTAL") return SegmentClass::kPortal;
-  throw InputError(source, "linesegment at " + lineOf(where) + " has class '" + text + "' (WALL or PORTAL)");
+  throw common::InputError(source, "linesegment at " + lineOf(where) + " has class '" + text + "' (WALL or PORTAL)");
 }
 
 DoorStatus parseStatus(const std::string& text, const XMLElement* where, const std::string& source) {
   if (text.empty()) return DoorStatus::kUnspecified;
   if (text == "OPEN") return DoorStatus::kOpen;
   if (text == "CLOSED") return DoorStatus::kClosed;
-  throw InputError(source, "<status> at " + lineOf(where) + " is '" + text + "' (OPEN or CLOSED)");
+  throw common::InputError(source, "<status> at " + lineOf(where) + " is '" + text + "' (OPEN or CLOSED)");
 }
 
 double wallAngle(const LineSegment& wall) {
-  return angleModuloPi(std::atan2(wall.b.y() - wall.a.y(), wall.b.x() - wall.a.x()));
+  return common::angleModuloPi(std::atan2(wall.b.y() - wall.a.y(), wall.b.x() - wall.a.x()));
 }
 
-bool isUsableWall(const LineSegment& segment, const Point2& centre, double tolerance) {
+bool isUsableWall(const LineSegment& segment, const common::Point2& centre, double tolerance) {
   return segment.segment_class == SegmentClass::kWall && (segment.b - segment.a).norm() > 1e-9 &&
-         distanceToSegment(centre, segment.a, segment.b) <= tolerance;
+         common::distanceToSegment(centre, segment.a, segment.b) <= tolerance;
 }
 
 // Angle (radians) between a wall and the nearest map axis.
@@ -111,12 +111,12 @@ double offAxisAngle(const LineSegment& wall) {
   return std::min(angle, kPi / 2.0 - angle);
 }
 
-bool insidePolygon(const Polygon& polygon, const Point2& p) {
+bool insidePolygon(const common::Polygon& polygon, const common::Point2& p) {
   bool inside = false;
   if (polygon.size() < 3) return false;
   for (size_t i = 0, j = polygon.size() - 1; i < polygon.size(); j = i++) {
-    const Point2& a = polygon[i];
-    const Point2& b = polygon[j];
+    const common::Point2& a = polygon[i];
+    const common::Point2& b = polygon[j];
     if ((a.y() > p.y()) != (b.y() > p.y()) && p.x() < (b.x() - a.x()) * (p.y() - a.y()) / (b.y() - a.y()) + a.x())
       inside = !inside;
   }
@@ -126,12 +126,12 @@ bool insidePolygon(const Polygon& polygon, const Point2& p) {
 // How many of the door's spaces are found stepping away from the door on both sides of a candidate wall
 // (0 to 2; 2 when one side lies in one joined space and the other side in the other).
 int sidesInJoinedSpaces(const Environment& environment, const Door& door, const LineSegment& wall) {
-  const Point2 along = (wall.b - wall.a).normalized();
-  const Point2 normal(-along.y(), along.x());
+  const common::Point2 along = (wall.b - wall.a).normalized();
+  const common::Point2 normal(-along.y(), along.x());
   std::vector<int> found;
   for (double side : {1.0, -1.0})
     for (double step : {0.25, 0.5, 0.75}) {
-      const Point2 probe = door.centre + side * step * normal;
+      const common::Point2 probe = door.centre + side * step * normal;
       const auto hit = std::find_if(door.space_indices.begin(), door.space_indices.end(), [&](int space) {
         return std::find(found.begin(), found.end(), space) == found.end() &&
                insidePolygon(environment.spaces[space].outline, probe);
@@ -168,10 +168,10 @@ const LineSegment* wallOfPortal(const Environment& environment, const Door& door
   return best;
 }
 
-void writePoint(tinyxml2::XMLPrinter* out, const Point2& pixel) {
+void writePoint(tinyxml2::XMLPrinter* out, const common::Point2& pixel) {
   out->OpenElement("point");
-  out->PushAttribute("x", formatNumber(pixel.x()).c_str());
-  out->PushAttribute("y", formatNumber(pixel.y()).c_str());
+  out->PushAttribute("x", common::formatNumber(pixel.x()).c_str());
+  out->PushAttribute("y", common::formatNumber(pixel.y()).c_str());
   out->CloseElement(true);
 }
 
@@ -197,21 +197,21 @@ int Environment::findDoor(const std::string& id_or_number) const {
   return -1;
 }
 
-std::pair<Point2, Point2> Environment::bounds() const {
+std::pair<common::Point2, common::Point2> Environment::bounds() const {
   const double inf = std::numeric_limits<double>::infinity();
-  Point2 low(inf, inf), high(-inf, -inf);
-  auto extend = [&](const Point2& p) {
+  common::Point2 low(inf, inf), high(-inf, -inf);
+  auto extend = [&](const common::Point2& p) {
     low = low.cwiseMin(p);
     high = high.cwiseMax(p);
   };
   for (const Space& space : spaces) {
-    for (const Point2& p : space.outline) extend(p);
+    for (const common::Point2& p : space.outline) extend(p);
     for (const LineSegment& segment : space.segments) {
       extend(segment.a);
       extend(segment.b);
     }
   }
-  if (low.x() > high.x()) return {Point2::Zero(), Point2::Zero()};
+  if (low.x() > high.x()) return {common::Point2::Zero(), common::Point2::Zero()};
   return {low, high};
 }
 
@@ -263,24 +263,24 @@ void deriveDoors(Environment* environment, const std::string& source_name) {
     if (wall == nullptr) {
       const double u = door.centre.x() / environment->metres_per_pixel;
       const double v = environment->flip_v - door.centre.y() / environment->metres_per_pixel;
-      throw InputError(source_name, "portal '" + door.id + "' at pixel (" + formatNumber(u) + ", " +
-                                        formatNumber(v) + ") lies on no wall");
+      throw common::InputError(source_name, "portal '" + door.id + "' at pixel (" + common::formatNumber(u) + ", " +
+                                                common::formatNumber(v) + ") lies on no wall");
     }
     door.wall_angle = wallAngle(*wall);
     door.orientation = std::abs(std::cos(door.wall_angle)) >= std::abs(std::sin(door.wall_angle))
-                           ? DoorOrientation::kAlongX
-                           : DoorOrientation::kAlongY;
+                           ? common::DoorOrientation::kAlongX
+                           : common::DoorOrientation::kAlongY;
   }
 }
 
 Environment parseEnvironment(const std::string& xml_text, const std::string& source) {
   tinyxml2::XMLDocument document;
   if (document.Parse(xml_text.c_str(), xml_text.size()) != tinyxml2::XML_SUCCESS)
-    throw InputError(source, std::string("malformed XML: ") + document.ErrorStr());
+    throw common::InputError(source, std::string("malformed XML: ") + document.ErrorStr());
   const XMLElement* building = document.RootElement();
   if (building == nullptr || std::string(building->Name()) != "building")
-    throw InputError(source, std::string("root element must be <building>, found <") +
-                                 (building != nullptr ? building->Name() : "nothing") + ">");
+    throw common::InputError(source, std::string("root element must be <building>, found <") +
+                                         (building != nullptr ? building->Name() : "nothing") + ">");
 
   Environment environment;
   environment.building_id = building->Attribute("id") != nullptr ? building->Attribute("id") : "";
@@ -290,7 +290,8 @@ Environment parseEnvironment(const std::string& xml_text, const std::string& sou
   environment.metres_per_pixel = readScale(building, source);
   if (const XMLElement* thickness = building->FirstChildElement("wall_thickness")) {
     const double value = parseNumber(childText(building, "wall_thickness"), thickness, "wall_thickness", source);
-    if (value <= 0.0) throw InputError(source, "<wall_thickness> at " + lineOf(thickness) + " must be positive");
+    if (value <= 0.0)
+      throw common::InputError(source, "<wall_thickness> at " + lineOf(thickness) + " must be positive");
     environment.wall_thickness = value;
   }
 
@@ -304,9 +305,9 @@ Environment parseEnvironment(const std::string& xml_text, const std::string& sou
        element = element->NextSiblingElement("space")) {
     Space space;
     space.id = element->Attribute("id") != nullptr ? element->Attribute("id") : "";
-    if (space.id.empty()) throw InputError(source, "<space> at " + lineOf(element) + " has no id");
+    if (space.id.empty()) throw common::InputError(source, "<space> at " + lineOf(element) + " has no id");
     if (!space_line.emplace(space.id, element->GetLineNum()).second)
-      throw InputError(source, "space id '" + space.id + "' at " + lineOf(element) + " is used twice");
+      throw common::InputError(source, "space id '" + space.id + "' at " + lineOf(element) + " is used twice");
     if (const XMLElement* labels = element->FirstChildElement("labels")) {
       space.type = childText(labels, "type");
       space.label = childText(labels, "label");
@@ -320,10 +321,11 @@ Environment parseEnvironment(const std::string& xml_text, const std::string& sou
            line = line->NextSiblingElement("linesegment")) {
         LineSegment segment;
         segment.id = line->Attribute("id") != nullptr ? line->Attribute("id") : "";
-        if (segment.id.empty()) throw InputError(source, "linesegment at " + lineOf(line) + " has no id");
+        if (segment.id.empty()) throw common::InputError(source, "linesegment at " + lineOf(line) + " has no id");
         const XMLElement* first = line->FirstChildElement("point");
         const XMLElement* second = first != nullptr ? first->NextSiblingElement("point") : nullptr;
-        if (second == nullptr) throw InputError(source, "linesegment at " + lineOf(line) + " needs two <point>s");
+        if (second == nullptr)
+          throw common::InputError(source, "linesegment at " + lineOf(line) + " needs two <point>s");
         segment.a = readPoint(first, source);
         segment.b = readPoint(second, source);
         segment.segment_class = parseSegmentClass(childText(line, "class"), line, source);
@@ -351,28 +353,28 @@ Environment parseEnvironment(const std::string& xml_text, const std::string& sou
         space.portals.push_back(link);
       }
     }
-    for (const Point2& p : space.outline) max_v = std::max(max_v, p.y());
+    for (const common::Point2& p : space.outline) max_v = std::max(max_v, p.y());
     for (const LineSegment& segment : space.segments) max_v = std::max({max_v, segment.a.y(), segment.b.y()});
     environment.spaces.push_back(std::move(space));
   }
-  if (environment.spaces.empty()) throw InputError(source, "the floor has no <space>");
+  if (environment.spaces.empty()) throw common::InputError(source, "the floor has no <space>");
 
   // XML pixels (y down) -> metres (y up).
   environment.flip_v = max_v;
   const double s = environment.metres_per_pixel;
-  auto toMetres = [&](const Point2& pixel) { return Point2(pixel.x() * s, (max_v - pixel.y()) * s); };
+  auto toMetres = [&](const common::Point2& pixel) { return common::Point2(pixel.x() * s, (max_v - pixel.y()) * s); };
   for (Space& space : environment.spaces) {
-    for (Point2& p : space.outline) p = toMetres(p);
+    for (common::Point2& p : space.outline) p = toMetres(p);
     for (LineSegment& segment : space.segments) {
       segment.a = toMetres(segment.a);
       segment.b = toMetres(segment.b);
     }
-    space.outline = withoutRepeatedVertices(space.outline);
+    space.outline = common::withoutRepeatedVertices(space.outline);
     if (space.outline.size() < 3) continue;  // degenerate (real files have a few): a space with no area
     std::string problem;
-    if (hasCrossing(space.outline, kOutlineCornerTolerance, &problem))
-      throw InputError(source, "outline of space '" + space.id + "' (line " +
-                                   std::to_string(space_line[space.id]) + ") crosses itself: " + problem);
+    if (common::hasCrossing(space.outline, kOutlineCornerTolerance, &problem))
+      throw common::InputError(source, "outline of space '" + space.id + "' (line " +
+                                           std::to_string(space_line[space.id]) + ") crosses itself: " + problem);
   }
   deriveDoors(&environment, source);
   for (Door& door : environment.doors) {
@@ -383,12 +385,12 @@ Environment parseEnvironment(const std::string& xml_text, const std::string& sou
 }
 
 Environment loadEnvironment(const std::string& path) {
-  return parseEnvironment(readTextFile(path, "environment file"), path);
+  return parseEnvironment(common::readTextFile(path, "environment file"), path);
 }
 
 std::string environmentToXml(const Environment& environment) {
   const double s = environment.metres_per_pixel;
-  auto toPixels = [&](const Point2& p) { return Point2(p.x() / s, environment.flip_v - p.y() / s); };
+  auto toPixels = [&](const common::Point2& p) { return common::Point2(p.x() / s, environment.flip_v - p.y() / s); };
   std::map<std::string, DoorStatus> status_of;
   for (const Door& door : environment.doors) status_of[door.id] = door.status;
 
@@ -409,7 +411,8 @@ std::string environmentToXml(const Environment& environment) {
   writeTextElement(&out, "um", "m");
   out.CloseElement();
   out.CloseElement();
-  if (environment.wall_thickness) writeTextElement(&out, "wall_thickness", formatNumber(*environment.wall_thickness));
+  if (environment.wall_thickness)
+    writeTextElement(&out, "wall_thickness", common::formatNumber(*environment.wall_thickness));
   out.OpenElement("building_type");
   writeTextElement(&out, "main_type", environment.building_type);
   out.CloseElement();
@@ -423,31 +426,31 @@ std::string environmentToXml(const Environment& environment) {
     writeTextElement(&out, "label", space.label);
     out.CloseElement();
 
-    Polygon pixels;
-    for (const Point2& p : space.outline) pixels.push_back(toPixels(p));
-    const double twice_area = 2.0 * signedArea(pixels);
-    Point2 centroid = Point2::Zero();
+    common::Polygon pixels;
+    for (const common::Point2& p : space.outline) pixels.push_back(toPixels(p));
+    const double twice_area = 2.0 * common::signedArea(pixels);
+    common::Point2 centroid = common::Point2::Zero();
     for (size_t i = 0; i < pixels.size(); ++i) {
-      const Point2& a = pixels[i];
-      const Point2& b = pixels[(i + 1) % pixels.size()];
+      const common::Point2& a = pixels[i];
+      const common::Point2& b = pixels[(i + 1) % pixels.size()];
       centroid += (a + b) * (a.x() * b.y() - b.x() * a.y());
     }
     if (std::abs(twice_area) > 1e-12) centroid /= 3.0 * twice_area;
     else if (!pixels.empty()) centroid = pixels.front();
     out.OpenElement("centroid");
     // Whole pixels as in the thesis's files; the bias keeps x.5 from flipping with rounding noise.
-    writePoint(&out, Point2(std::floor(centroid.x() + 0.5 + 1e-6), std::floor(centroid.y() + 0.5 + 1e-6)));
+    writePoint(&out, common::Point2(std::floor(centroid.x() + 0.5 + 1e-6), std::floor(centroid.y() + 0.5 + 1e-6)));
     out.CloseElement();
     out.OpenElement("bounding_box");
-    const std::pair<const char*, std::function<bool(const Point2&, const Point2&)>> extremes[] = {
-        {"maxx", [](const Point2& a, const Point2& b) { return a.x() > b.x(); }},
-        {"maxy", [](const Point2& a, const Point2& b) { return a.y() > b.y(); }},
-        {"minx", [](const Point2& a, const Point2& b) { return a.x() < b.x(); }},
-        {"miny", [](const Point2& a, const Point2& b) { return a.y() < b.y(); }}};
+    const std::pair<const char*, std::function<bool(const common::Point2&, const common::Point2&)>> extremes[] = {
+        {"maxx", [](const common::Point2& a, const common::Point2& b) { return a.x() > b.x(); }},
+        {"maxy", [](const common::Point2& a, const common::Point2& b) { return a.y() > b.y(); }},
+        {"minx", [](const common::Point2& a, const common::Point2& b) { return a.x() < b.x(); }},
+        {"miny", [](const common::Point2& a, const common::Point2& b) { return a.y() < b.y(); }}};
     for (const auto& [name, better] : extremes) {
       if (pixels.empty()) break;
-      Point2 extreme = pixels.front();
-      for (const Point2& p : pixels)
+      common::Point2 extreme = pixels.front();
+      for (const common::Point2& p : pixels)
         if (better(p, extreme)) extreme = p;
       out.OpenElement(name);
       writePoint(&out, extreme);
@@ -455,7 +458,7 @@ std::string environmentToXml(const Environment& environment) {
     }
     out.CloseElement();
     out.OpenElement("bounding_polygon");
-    for (const Point2& p : pixels) writePoint(&out, p);
+    for (const common::Point2& p : pixels) writePoint(&out, p);
     if (pixels.size() >= 3) writePoint(&out, pixels.front());  // closed, as the thesis's files are
     out.CloseElement();
 
@@ -499,7 +502,7 @@ std::string environmentToXml(const Environment& environment) {
 }
 
 void saveEnvironment(const Environment& environment, const std::string& path) {
-  writeTextAtomically(path, environmentToXml(environment), "environment file");
+  common::writeTextAtomically(path, environmentToXml(environment), "environment file");
 }
 
 std::vector<int> closableDoors(const Environment& environment) {
@@ -518,7 +521,8 @@ int roomBehindDoor(const Environment& environment, int door_index) {
   int best = -1;
   for (int space : door.space_indices) {
     if (doors_per_space[space] != 1) continue;
-    if (best < 0 || area(environment.spaces[space].outline) < area(environment.spaces[best].outline)) best = space;
+    if (best < 0 || common::area(environment.spaces[space].outline) < common::area(environment.spaces[best].outline))
+      best = space;
   }
   return best;
 }
@@ -543,11 +547,11 @@ std::set<int> parseDoorSelection(const Environment& environment, const std::stri
     if (item.empty()) continue;
     const int index = environment.findDoor(item);
     if (index < 0)
-      throw InputError(source_name, "no door '" + item + "' (door numbers are 1.." +
-                                        std::to_string(environment.doors.size()) + ", or use portal ids)");
+      throw common::InputError(source_name, "no door '" + item + "' (door numbers are 1.." +
+                                                std::to_string(environment.doors.size()) + ", or use portal ids)");
     selected.insert(index);
   }
   return selected;
 }
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::world

@@ -8,7 +8,7 @@
 #include "hidden_rooms/common/image_io.h"
 #include "hidden_rooms/common/input_error.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::world {
 
 namespace {
 
@@ -19,10 +19,10 @@ constexpr double kSameLineAngle = 10.0 * 3.14159265358979323846 / 180.0;
 constexpr double kMaxDoubleWallOffset = 0.5;
 
 // Map-frame polygon -> OpenCV integer vertices (cell centres at integer coordinates, fixed point).
-std::vector<cv::Point> toCvPolygon(const OccupancyGrid& grid, const Polygon& polygon) {
+std::vector<cv::Point> toCvPolygon(const common::OccupancyGrid& grid, const common::Polygon& polygon) {
   std::vector<cv::Point> points;
-  for (const Point2& p : polygon) {
-    const Point2 image = grid.toImage(p) - Point2(0.5, 0.5);
+  for (const common::Point2& p : polygon) {
+    const common::Point2 image = grid.toImage(p) - common::Point2(0.5, 0.5);
     points.emplace_back(static_cast<int>(std::lround(image.x() * (1 << kSubpixelBits))),
                         static_cast<int>(std::lround(image.y() * (1 << kSubpixelBits))));
   }
@@ -30,16 +30,16 @@ std::vector<cv::Point> toCvPolygon(const OccupancyGrid& grid, const Polygon& pol
 }
 
 // Rectangle centred on segment [a, b] with half-width `half_across`, extended by `cap` beyond both ends.
-Polygon segmentRectangle(const Point2& a, const Point2& b, double half_across, double cap) {
-  const Point2 along = (b - a).norm() > 0 ? Point2((b - a).normalized()) : Point2(1, 0);
-  const Point2 across(-along.y(), along.x());
-  const Point2 start = a - cap * along, end = b + cap * along;
+common::Polygon segmentRectangle(const common::Point2& a, const common::Point2& b, double half_across, double cap) {
+  const common::Point2 along = (b - a).norm() > 0 ? common::Point2((b - a).normalized()) : common::Point2(1, 0);
+  const common::Point2 across(-along.y(), along.x());
+  const common::Point2 start = a - cap * along, end = b + cap * along;
   return {start + half_across * across, end + half_across * across, end - half_across * across,
           start - half_across * across};
 }
 
 template <typename T>
-void fillPolygon(cv::Mat_<T>* image, const OccupancyGrid& grid, const Polygon& polygon, T value) {
+void fillPolygon(cv::Mat_<T>* image, const common::OccupancyGrid& grid, const common::Polygon& polygon, T value) {
   if (polygon.size() < 3) return;
   const std::vector<std::vector<cv::Point>> polygons{toCvPolygon(grid, polygon)};
   cv::fillPoly(*image, polygons, cv::Scalar(value), cv::LINE_8, kSubpixelBits);
@@ -56,11 +56,11 @@ bool isOpen(const Door& door, int index, const std::set<int>& closed) {
 
 void validate(const RenderOptions& options, double wall_thickness) {
   auto positive = [](double value) { return std::isfinite(value) && value > 0.0; };
-  if (!positive(options.resolution)) throw InputError("render options", "resolution must be positive");
-  if (!positive(options.door_width)) throw InputError("render options", "door width must be positive");
-  if (!positive(wall_thickness)) throw InputError("render options", "wall thickness must be positive");
+  if (!positive(options.resolution)) throw common::InputError("render options", "resolution must be positive");
+  if (!positive(options.door_width)) throw common::InputError("render options", "door width must be positive");
+  if (!positive(wall_thickness)) throw common::InputError("render options", "wall thickness must be positive");
   if (!std::isfinite(options.margin) || options.margin < 0.0)
-    throw InputError("render options", "margin must be zero or positive");
+    throw common::InputError("render options", "margin must be zero or positive");
 }
 
 }  // namespace
@@ -72,7 +72,7 @@ WallGeometry wallGeometry(const Environment& environment, const std::set<int>& o
   validate(options, thickness);
   for (int index : open_door_indices)
     if (index < 0 || index >= static_cast<int>(environment.doors.size()))
-      throw InputError("render options", "open door index " + std::to_string(index) + " does not exist");
+      throw common::InputError("render options", "open door index " + std::to_string(index) + " does not exist");
   WallGeometry geometry;
   geometry.thickness = thickness;
   geometry.door_leaves.resize(environment.doors.size());
@@ -89,20 +89,20 @@ WallGeometry wallGeometry(const Environment& environment, const std::set<int>& o
     for (const LineSegment& segment : environment.spaces[s].segments) {
       const double length = (segment.b - segment.a).norm();
       if (segment.segment_class != SegmentClass::kWall || length <= 1e-9) continue;
-      const Point2 a = segment.a, b = segment.b;
+      const common::Point2 a = segment.a, b = segment.b;
       std::vector<std::pair<double, double>> solid{{0.0, 1.0}};  // parameter intervals along a -> b left standing
-      const Point2 direction = (b - a) / length;
+      const common::Point2 direction = (b - a) / length;
       const double wall_angle = std::atan2(direction.y(), direction.x());
       for (int d : open_doors) {
         const Door& door = environment.doors[d];
         if (angleBetweenLines(wall_angle, door.wall_angle) > kSameLineAngle) continue;
-        const double t = projectionParameter(door.centre, a, b);
+        const double t = common::projectionParameter(door.centre, a, b);
         const double offset = std::abs(direction.x() * (door.centre.y() - a.y()) -
                                        direction.y() * (door.centre.x() - a.x()));
         const double half_cut = (0.5 * options.door_width + 0.5 * thickness) / length;
         const bool joins_space = std::find(door.space_indices.begin(), door.space_indices.end(),
                                            static_cast<int>(s)) != door.space_indices.end();
-        const bool on_this_wall = distanceToSegment(door.centre, a, b) <= on_wall_tolerance;
+        const bool on_this_wall = common::distanceToSegment(door.centre, a, b) <= on_wall_tolerance;
         const bool double_wall = joins_space && offset <= kMaxDoubleWallOffset && t > -half_cut && t < 1.0 + half_cut;
         if (!on_this_wall && !double_wall) continue;
         door_half_depth[d] = std::max(door_half_depth[d], offset + 0.5 * thickness + options.resolution);
@@ -124,7 +124,7 @@ WallGeometry wallGeometry(const Environment& environment, const std::set<int>& o
   }
   for (int d : open_doors) {
     const Door& door = environment.doors[d];
-    const Point2 along(std::cos(door.wall_angle), std::sin(door.wall_angle));
+    const common::Point2 along(std::cos(door.wall_angle), std::sin(door.wall_angle));
     const double half = 0.5 * options.door_width;
     geometry.door_openings[d] =
         segmentRectangle(door.centre - half * along, door.centre + half * along, door_half_depth[d], 0.0);
@@ -139,24 +139,24 @@ RenderedEnvironment renderEnvironment(const Environment& environment, const std:
   validate(options, thickness);
   for (int index : closed_door_indices)
     if (index < 0 || index >= static_cast<int>(environment.doors.size()))
-      throw InputError("render options", "closed door index " + std::to_string(index) + " does not exist");
+      throw common::InputError("render options", "closed door index " + std::to_string(index) + " does not exist");
 
   const auto [low, high] = environment.bounds();
   const double resolution = options.resolution;
   RenderedEnvironment result;
   result.wall_thickness = thickness;
-  OccupancyGrid& grid = result.map;
+  common::OccupancyGrid& grid = result.map;
   grid.resolution = resolution;
   grid.origin = ((low.array() - options.margin) / resolution).floor() * resolution;
   const Eigen::Array2d cells = ((high - grid.origin).array() + options.margin) / resolution;
   if (cells.x() * cells.y() > kMaxCells)
-    throw InputError("render options", "the map would have more than 4e8 cells: raise the resolution");
+    throw common::InputError("render options", "the map would have more than 4e8 cells: raise the resolution");
   grid.cells.create(static_cast<int>(std::ceil(cells.y())), static_cast<int>(std::ceil(cells.x())));
-  grid.cells.setTo(OccupancyGrid::kUnknown);
+  grid.cells.setTo(common::OccupancyGrid::kUnknown);
   result.space_labels = cv::Mat1w::zeros(grid.cells.size());
 
   for (size_t s = 0; s < environment.spaces.size(); ++s) {
-    fillPolygon<int8_t>(&grid.cells, grid, environment.spaces[s].outline, OccupancyGrid::kFree);
+    fillPolygon<int8_t>(&grid.cells, grid, environment.spaces[s].outline, common::OccupancyGrid::kFree);
     fillPolygon<uint16_t>(&result.space_labels, grid, environment.spaces[s].outline, static_cast<uint16_t>(s + 1));
   }
 
@@ -164,15 +164,17 @@ RenderedEnvironment renderEnvironment(const Environment& environment, const std:
   for (size_t d = 0; d < environment.doors.size(); ++d)
     if (isOpen(environment.doors[d], static_cast<int>(d), closed_door_indices)) open_doors.insert(static_cast<int>(d));
   const WallGeometry geometry = wallGeometry(environment, open_doors, options);
-  for (const Polygon& opening : geometry.door_openings) fillPolygon<int8_t>(&grid.cells, grid, opening, OccupancyGrid::kFree);
-  for (const Polygon& wall : geometry.walls) fillPolygon<int8_t>(&grid.cells, grid, wall, OccupancyGrid::kOccupied);
-  result.space_labels.setTo(0, grid.cells != OccupancyGrid::kFree);
+  for (const common::Polygon& opening : geometry.door_openings)
+    fillPolygon<int8_t>(&grid.cells, grid, opening, common::OccupancyGrid::kFree);
+  for (const common::Polygon& wall : geometry.walls)
+    fillPolygon<int8_t>(&grid.cells, grid, wall, common::OccupancyGrid::kOccupied);
+  result.space_labels.setTo(0, grid.cells != common::OccupancyGrid::kFree);
 
   result.closed_doors.frame = "map";
   for (size_t d = 0; d < environment.doors.size(); ++d) {
     const Door& door = environment.doors[d];
     if (closed_door_indices.count(static_cast<int>(d)) == 0 && door.status != DoorStatus::kClosed) continue;
-    MapDoor closed;
+    common::MapDoor closed;
     closed.id = door.number;
     closed.position = door.centre;
     closed.width = options.door_width;
@@ -193,28 +195,28 @@ HiddenRoomsCase hideClosedRooms(const Environment& environment, const RenderedEn
     const int door = environment.findDoor(std::to_string(rendered.closed_doors.doors[k].id));
     const int room = door >= 0 ? roomBehindDoor(environment, door) : -1;
     if (room < 0)
-      throw InputError("closed doors", "door " + std::to_string(rendered.closed_doors.doors[k].id) +
-                                           " is not closable: no room lies behind it alone");
+      throw common::InputError("closed doors", "door " + std::to_string(rendered.closed_doors.doors[k].id) +
+                                                   " is not closable: no room lies behind it alone");
     const cv::Mat1b cells = rendered.space_labels == room + 1;
     hidden.true_rooms.setTo(static_cast<uint16_t>(k + 1), cells);
     hidden_free |= cells;
   }
   // Walls within reach of a hidden room and out of reach of every explored free cell are unseen too.
-  const cv::Mat1b visible_free = (rendered.map.cells == OccupancyGrid::kFree) & ~hidden_free;
-  const cv::Mat1b occupied = rendered.map.cells == OccupancyGrid::kOccupied;
+  const cv::Mat1b visible_free = (rendered.map.cells == common::OccupancyGrid::kFree) & ~hidden_free;
+  const cv::Mat1b occupied = rendered.map.cells == common::OccupancyGrid::kOccupied;
   cv::Mat1f to_visible, to_hidden;
   cv::distanceTransform(~visible_free, to_visible, cv::DIST_L2, cv::DIST_MASK_PRECISE);
   cv::distanceTransform(~hidden_free, to_hidden, cv::DIST_L2, cv::DIST_MASK_PRECISE);
   // A wall cell is seen when it lies within the wall's full thickness of explored free space.
   const double thickness_cells = rendered.wall_thickness / rendered.map.resolution + 1.0;
   const cv::Mat1b near_visible = to_visible <= static_cast<float>(thickness_cells);
-  hidden.map.cells.setTo(OccupancyGrid::kUnknown, hidden_free);
-  hidden.map.cells.setTo(OccupancyGrid::kUnknown, occupied & ~near_visible & (to_hidden < to_visible));
+  hidden.map.cells.setTo(common::OccupancyGrid::kUnknown, hidden_free);
+  hidden.map.cells.setTo(common::OccupancyGrid::kUnknown, occupied & ~near_visible & (to_hidden < to_visible));
   return hidden;
 }
 
 cv::Mat3b renderPreview(const Environment& environment, const RenderedEnvironment& rendered) {
-  const OccupancyGrid& grid = rendered.map;
+  const common::OccupancyGrid& grid = rendered.map;
   cv::Mat3b preview;
   cv::cvtColor(grid.toGreyImage(), preview, cv::COLOR_GRAY2BGR);
   // Pastel tint per space, from a fixed hue sequence (golden-angle steps).
@@ -229,9 +231,9 @@ cv::Mat3b renderPreview(const Environment& environment, const RenderedEnvironmen
     }
   const int radius = std::max(3, static_cast<int>(std::lround(0.3 / grid.resolution)));
   std::set<int> closed_numbers;
-  for (const MapDoor& door : rendered.closed_doors.doors) closed_numbers.insert(door.id);
+  for (const common::MapDoor& door : rendered.closed_doors.doors) closed_numbers.insert(door.id);
   for (const Door& door : environment.doors) {
-    const Point2 image = grid.toImage(door.centre);
+    const common::Point2 image = grid.toImage(door.centre);
     const cv::Point centre(static_cast<int>(image.x()), static_cast<int>(image.y()));
     const bool closed = closed_numbers.count(door.number) > 0;
     if (door.space_indices.size() < 2 && !closed) continue;
@@ -244,4 +246,4 @@ cv::Mat3b renderPreview(const Environment& environment, const RenderedEnvironmen
   return preview;
 }
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::world

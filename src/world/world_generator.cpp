@@ -13,7 +13,7 @@
 
 #include "hidden_rooms/common/input_error.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::world {
 
 namespace {
 
@@ -557,7 +557,7 @@ Environment toEnvironment(const FloorPlan& plan, const WorldIdentity& identity) 
   auto spaceId = [](int s) { return "s" + std::to_string(s + 1); };
   // Pixels times metres_per_pixel, exactly as the XML reader computes metres, so a written and re-read world
   // is bit-identical.
-  auto toMetres = [](const GridPoint& p) { return Point2(p.x * kMetresPerUnit, p.y * kMetresPerUnit); };
+  auto toMetres = [](const GridPoint& p) { return common::Point2(p.x * kMetresPerUnit, p.y * kMetresPerUnit); };
 
   Environment environment;
   environment.building_id = identity.building_id;
@@ -628,7 +628,7 @@ const char* toString(SizeClass size_class) {
 SizeClass parseSizeClass(const std::string& text) {
   for (SizeClass size_class : {SizeClass::kSmall, SizeClass::kMedium, SizeClass::kLarge})
     if (text == toString(size_class)) return size_class;
-  throw InputError("command line", "unknown size class '" + text + "' (small|medium|large)");
+  throw common::InputError("command line", "unknown size class '" + text + "' (small|medium|large)");
 }
 
 Environment generateWorld(std::uint32_t seed, SizeClass size_class) {
@@ -652,4 +652,4 @@ Environment generateWorld(std::uint32_t seed, SizeClass size_class) {
                          std::to_string(kMaxAttempts) + " attempts (seed " + std::to_string(seed) + ")");
 }
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::world

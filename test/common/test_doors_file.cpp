@@ -7,7 +7,7 @@
 #include "hidden_rooms/common/occupancy_grid.h"
 #include "test_util.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::common {
 namespace {
 
 TEST(DoorsFile, ReadsEveryBenchmarkDoorsFileInsideItsMap) {
@@ -84,4 +84,4 @@ TEST(DoorsFile, BadDoorsFilesGiveClearErrors) {
 }
 
 }  // namespace
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::common

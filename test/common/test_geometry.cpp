@@ -4,7 +4,7 @@
 
 #include "hidden_rooms/common/geometry.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::common {
 namespace {
 
 TEST(Geometry, AreaOfPolygons) {
@@ -46,4 +46,4 @@ TEST(Geometry, DistanceToSegment) {
 }
 
 }  // namespace
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::common

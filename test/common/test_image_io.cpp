@@ -14,7 +14,7 @@
 #include "test_util.h"
 
 // OpenCV's imgcodecs (not linked into the package's libraries) is the independent reference here.
-namespace hidden_rooms {
+namespace hidden_rooms::common {
 namespace {
 
 bool sameImage(const cv::Mat& a, const cv::Mat& b) {
@@ -120,9 +120,9 @@ TEST(ImageIo, ReadsTheBenchmarkImagesLikeOpenCv) {
 }
 
 }  // namespace
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::common
 
-namespace hidden_rooms {
+namespace hidden_rooms::common {
 namespace {
 
 TEST(FileIo, WritesAtomicallyAndLeavesNoPartialFile) {
@@ -165,4 +165,4 @@ TEST(FileIo, RemovesTheTemporariesOfKilledWriters) {
 }
 
 }  // namespace
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::common

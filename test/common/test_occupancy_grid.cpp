@@ -9,7 +9,7 @@
 #include "hidden_rooms/common/occupancy_grid.h"
 #include "test_util.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::common {
 namespace {
 
 void writeText(const std::string& path, const std::string& text) { std::ofstream(path) << text; }
@@ -150,4 +150,4 @@ TEST(OccupancyGrid, RefusesToSaveAnEmptyMap) {
 }
 
 }  // namespace
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::common

@@ -12,15 +12,17 @@
 #include "hidden_rooms/evaluation/batch_case.h"
 #include "test_util.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::evaluation {
 namespace {
 
 const std::string kBatchCases = BATCH_CASES_BIN;
 
-Environment corridorWorld() { return parseEnvironment(testing::corridorWithTwoRoomsXml(), "corridor.xml"); }
+world::Environment corridorWorld() {
+  return world::parseEnvironment(testing::corridorWithTwoRoomsXml(), "corridor.xml");
+}
 
 TEST(BatchCase, ErasesTheClosedRoomsAndScoresTheMethods) {
-  const Environment environment = corridorWorld();
+  const world::Environment environment = corridorWorld();
   const BatchCase one = makeBatchCase(environment, {2});
   ASSERT_EQ(one.input.closed_doors.doors.size(), 1u);
   EXPECT_EQ(one.input.closed_doors.doors[0].id, 2);
@@ -28,7 +30,7 @@ TEST(BatchCase, ErasesTheClosedRoomsAndScoresTheMethods) {
   EXPECT_NEAR(one.hidden_percent, 40.0, 3.0);
   const cv::Mat1b room_b = one.input.true_rooms == 1;
   EXPECT_GT(cv::countNonZero(room_b), 0);
-  EXPECT_EQ(cv::countNonZero((one.input.map.cells != OccupancyGrid::kUnknown) & room_b), 0);
+  EXPECT_EQ(cv::countNonZero((one.input.map.cells != common::OccupancyGrid::kUnknown) & room_b), 0);
 
   const BatchCase both = makeBatchCase(environment, {2, 1});
   ASSERT_EQ(both.input.closed_doors.doors.size(), 2u);
@@ -36,8 +38,8 @@ TEST(BatchCase, ErasesTheClosedRoomsAndScoresTheMethods) {
   EXPECT_EQ(both.closed_door_numbers, (std::vector<int>{2, 1}));
   EXPECT_GT(both.hidden_percent, one.hidden_percent);
 
-  for (const std::string& name : roomPredictorNames()) {
-    const MethodOutcome outcome = runMethodOnCase(*makeRoomPredictor(name), both);
+  for (const std::string& name : prediction::roomPredictorNames()) {
+    const MethodOutcome outcome = runMethodOnCase(*prediction::makeRoomPredictor(name), both);
     EXPECT_EQ(outcome.method, name);
     EXPECT_TRUE(outcome.problem.empty()) << name << ": " << outcome.problem;
     ASSERT_EQ(outcome.scores.iou.size(), 2u) << name;
@@ -46,35 +48,35 @@ TEST(BatchCase, ErasesTheClosedRoomsAndScoresTheMethods) {
     EXPECT_GT(outcome.seconds, 0.0);
   }
   // With room A known, the unstructured baseline's bounding box holds room B.
-  EXPECT_GT(runMethodOnCase(*makeRoomPredictor("unstructured"), one).scores.mean_iou, 0.5);
+  EXPECT_GT(runMethodOnCase(*prediction::makeRoomPredictor("unstructured"), one).scores.mean_iou, 0.5);
 }
 
 TEST(BatchCase, AMethodThatFailsScoresZeroWithItsProblem) {
   const BatchCase batch_case = makeBatchCase(corridorWorld(), {1});
   const MethodOutcome outcome =
-      runMethodOnCase(*makeRoomPredictor("unstructured"), batch_case, {{"no_such_parameter", 1.0}});
+      runMethodOnCase(*prediction::makeRoomPredictor("unstructured"), batch_case, {{"no_such_parameter", 1.0}});
   EXPECT_FALSE(outcome.problem.empty());
   EXPECT_EQ(outcome.scores.mean_iou, 0.0);
   EXPECT_EQ(outcome.scores.iou.size(), 1u);
 }
 
 TEST(BatchCase, BadDoorsThrow) {
-  const Environment environment = corridorWorld();
-  EXPECT_THROW(makeBatchCase(environment, {3}), InputError);     // no such door
-  EXPECT_THROW(makeBatchCase(environment, {1, 1}), InputError);  // closed twice
+  const world::Environment environment = corridorWorld();
+  EXPECT_THROW(makeBatchCase(environment, {3}), common::InputError);     // no such door
+  EXPECT_THROW(makeBatchCase(environment, {1, 1}), common::InputError);  // closed twice
 }
 
 TEST(BatchCase, FromACompleteMapMatchesTheRendering) {
-  const Environment environment = corridorWorld();
-  const RenderedEnvironment complete = renderEnvironment(environment, {});
+  const world::Environment environment = corridorWorld();
+  const world::RenderedEnvironment complete = world::renderEnvironment(environment, {});
   const cv::Mat complete_before = complete.map.cells.clone();
-  DoorsFile doors_in_map;  // every door where the rendering puts it, in a frame shifted by (3, -2)
-  OccupancyGrid shifted = complete.map;
-  shifted.origin += Point2(3.0, -2.0);
-  for (const Door& door : environment.doors) {
-    MapDoor entry;
+  common::DoorsFile doors_in_map;  // every door where the rendering puts it, in a frame shifted by (3, -2)
+  common::OccupancyGrid shifted = complete.map;
+  shifted.origin += common::Point2(3.0, -2.0);
+  for (const world::Door& door : environment.doors) {
+    common::MapDoor entry;
     entry.id = door.number;
-    entry.position = door.centre + Point2(3.0, -2.0);
+    entry.position = door.centre + common::Point2(3.0, -2.0);
     doors_in_map.doors.push_back(entry);
   }
   const BatchCase from_map = makeBatchCaseFromMap(environment, shifted, doors_in_map, {2});
@@ -86,14 +88,14 @@ TEST(BatchCase, FromACompleteMapMatchesTheRendering) {
   const double iou = static_cast<double>(cv::countNonZero(a & b)) / cv::countNonZero(a | b);
   EXPECT_GT(iou, 0.95);
   EXPECT_NEAR(from_map.hidden_percent, rendered.hidden_percent, 3.0);
-  EXPECT_EQ(cv::countNonZero((from_map.input.map.cells != OccupancyGrid::kUnknown) & a), 0);
-  const MethodOutcome outcome = runMethodOnCase(*makeRoomPredictor("unstructured"), from_map);
+  EXPECT_EQ(cv::countNonZero((from_map.input.map.cells != common::OccupancyGrid::kUnknown) & a), 0);
+  const MethodOutcome outcome = runMethodOnCase(*prediction::makeRoomPredictor("unstructured"), from_map);
   EXPECT_GT(outcome.scores.mean_iou, 0.5) << outcome.problem;
 
-  DoorsFile one_door;
+  common::DoorsFile one_door;
   one_door.doors.push_back(doors_in_map.doors[1]);
-  EXPECT_THROW(makeBatchCaseFromMap(environment, shifted, one_door, {2}), InputError);
-  EXPECT_THROW(makeBatchCaseFromMap(environment, shifted, doors_in_map, {3}), InputError);
+  EXPECT_THROW(makeBatchCaseFromMap(environment, shifted, one_door, {2}), common::InputError);
+  EXPECT_THROW(makeBatchCaseFromMap(environment, shifted, doors_in_map, {3}), common::InputError);
 }
 
 TEST(BatchCasesTool, PrintsOneJsonLinePerCaseAndFailsClearly) {
@@ -172,4 +174,4 @@ TEST(BatchCasesTool, SigkillLeavesNoPartialCaseFiles) {
 }
 
 }  // namespace
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::evaluation

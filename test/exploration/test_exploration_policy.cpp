@@ -9,7 +9,7 @@
 
 #include "hidden_rooms/exploration/exploration_policy.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::exploration {
 namespace {
 
 using Type = ExplorationEventType;
@@ -18,23 +18,23 @@ using Type = ExplorationEventType;
 // unknown ends (x < 1.0 and x > 9.0); an end that is not open has a wall (no frontier there). Goals on the
 // frontiers' side of the robot lie 0.5 m inside the corridor (goal_reach 0.6 m is 5 whole cells): x = 1.55 and
 // 8.45.
-OccupancyGrid corridor(bool left_open, bool right_open) {
-  OccupancyGrid grid;
+common::OccupancyGrid corridor(bool left_open, bool right_open) {
+  common::OccupancyGrid grid;
   grid.resolution = 0.1;
-  grid.cells = cv::Mat_<int8_t>(32, 100, OccupancyGrid::kUnknown);
-  grid.cells(cv::Rect(0, 0, 100, 1)).setTo(OccupancyGrid::kOccupied);
-  grid.cells(cv::Rect(0, 31, 100, 1)).setTo(OccupancyGrid::kOccupied);
-  grid.cells(cv::Rect(10, 1, 80, 30)).setTo(OccupancyGrid::kFree);
-  if (!left_open) grid.cells(cv::Rect(9, 1, 1, 30)).setTo(OccupancyGrid::kOccupied);
-  if (!right_open) grid.cells(cv::Rect(90, 1, 1, 30)).setTo(OccupancyGrid::kOccupied);
+  grid.cells = cv::Mat_<int8_t>(32, 100, common::OccupancyGrid::kUnknown);
+  grid.cells(cv::Rect(0, 0, 100, 1)).setTo(common::OccupancyGrid::kOccupied);
+  grid.cells(cv::Rect(0, 31, 100, 1)).setTo(common::OccupancyGrid::kOccupied);
+  grid.cells(cv::Rect(10, 1, 80, 30)).setTo(common::OccupancyGrid::kFree);
+  if (!left_open) grid.cells(cv::Rect(9, 1, 1, 30)).setTo(common::OccupancyGrid::kOccupied);
+  if (!right_open) grid.cells(cv::Rect(90, 1, 1, 30)).setTo(common::OccupancyGrid::kOccupied);
   return grid;
 }
 
 // A closed room, every cell known: no frontier.
-OccupancyGrid closedRoom() {
-  OccupancyGrid grid = corridor(false, false);
-  grid.cells.setTo(OccupancyGrid::kOccupied);
-  grid.cells(cv::Rect(10, 1, 80, 30)).setTo(OccupancyGrid::kFree);
+common::OccupancyGrid closedRoom() {
+  common::OccupancyGrid grid = corridor(false, false);
+  grid.cells.setTo(common::OccupancyGrid::kOccupied);
+  grid.cells(cv::Rect(10, 1, 80, 30)).setTo(common::OccupancyGrid::kFree);
   return grid;
 }
 
@@ -62,7 +62,7 @@ const ExplorationEvent& first(const ExplorationStep& step, Type type) {
 
 // Steps at 10 Hz from *time on with poses from `pose_at` until an event of `type` comes (at most `seconds`).
 ExplorationStep runUntil(ExplorationPolicy* policy, double* time, Type type, double seconds,
-                         const std::function<Pose2(double)>& pose_at) {
+                         const std::function<common::Pose2(double)>& pose_at) {
   const double end = *time + seconds;
   while (*time < end) {
     *time += 0.1;
@@ -88,19 +88,19 @@ ExplorationPolicyOptions quickFailures() {
 }
 
 // A robot at `x` on the corridor's centre line that stands still (its recoveries move nothing: stuck).
-std::function<Pose2(double)> standing(double x) {
-  return [x](double) { return Pose2{x, kCentreY, 0.0}; };
+std::function<common::Pose2(double)> standing(double x) {
+  return [x](double) { return common::Pose2{x, kCentreY, 0.0}; };
 }
 
 // A robot at `x` that turns on the spot (it moves, so no stall, but makes no progress along its path).
-std::function<Pose2(double)> turning(double x) {
-  return [x](double time) { return Pose2{x, kCentreY, 2.0 * time}; };
+std::function<common::Pose2(double)> turning(double x) {
+  return [x](double time) { return common::Pose2{x, kCentreY, 2.0 * time}; };
 }
 
 TEST(ExplorationPolicy, ChoosesTheNearestFrontierAndDrivesThere) {
   ExplorationPolicy policy;
   policy.setMap(corridor(false, true));
-  Pose2 pose{5.05, kCentreY, 0.0};
+  common::Pose2 pose{5.05, kCentreY, 0.0};
   ExplorationStep step = policy.update(pose, 0.1);
   EXPECT_TRUE(step.planned);
   ASSERT_EQ(types(step), std::vector<Type>{Type::kGoalChosen});
@@ -134,11 +134,11 @@ TEST(ExplorationPolicy, ChoosesTheNearestFrontierAndDrivesThere) {
 TEST(ExplorationPolicy, AReachedGoalIsBlacklisted) {
   ExplorationPolicy policy;
   policy.setMap(corridor(false, true));
-  policy.update(Pose2{5.05, kCentreY, 0.0}, 0.1);
+  policy.update(common::Pose2{5.05, kCentreY, 0.0}, 0.1);
   ASSERT_TRUE(policy.goal());
-  const Point2 reached = policy.goal()->position;
+  const common::Point2 reached = policy.goal()->position;
   // The robot stands at the goal; the frontier is still there (the map did not change).
-  const ExplorationStep step = policy.update(Pose2{reached.x(), reached.y(), 0.0}, 0.2);
+  const ExplorationStep step = policy.update(common::Pose2{reached.x(), reached.y(), 0.0}, 0.2);
   EXPECT_EQ(types(step), (std::vector<Type>{Type::kGoalReached, Type::kGoalChosen}));
   EXPECT_TRUE(policy.blacklist().contains(reached));
   ASSERT_TRUE(policy.goal());
@@ -154,9 +154,9 @@ TEST(ExplorationPolicy, AFailedGoalGetsOneSecondTry) {
   ExplorationPolicy policy(options);
   policy.setMap(corridor(false, true));
   double time = 0.1;
-  policy.update(Pose2{5.05, kCentreY, 0.0}, time);
+  policy.update(common::Pose2{5.05, kCentreY, 0.0}, time);
   ASSERT_TRUE(policy.goal());
-  const Point2 goal = policy.goal()->position;
+  const common::Point2 goal = policy.goal()->position;
 
   // It fails while the robot moves: blacklisted, and as nothing else is left, tried again at once.
   ExplorationStep step = runUntil(&policy, &time, Type::kGoalFailed, 10.0, turning(5.05));
@@ -185,7 +185,7 @@ TEST(ExplorationPolicy, ReleasesStuckPlacesBeforeBlockedPassagesBeforeFailedGoal
   ExplorationPolicy policy(options);
   policy.setMap(corridor(true, true));
   double time = 0.1;
-  ExplorationStep step = policy.update(Pose2{5.05, kCentreY, 0.0}, time);
+  ExplorationStep step = policy.update(common::Pose2{5.05, kCentreY, 0.0}, time);
   ASSERT_TRUE(policy.goal());
   EXPECT_NEAR(policy.goal()->position.x(), kRightGoalX, 1e-9);
 
@@ -208,8 +208,8 @@ TEST(ExplorationPolicy, ReleasesStuckPlacesBeforeBlockedPassagesBeforeFailedGoal
 
   // The left goal is reached: with the right one failed and its passage blocked, the passage is opened first,
   // then the failed place released, which gives the goal.
-  const Point2 left = policy.goal()->position;
-  step = policy.update(Pose2{left.x(), left.y(), M_PI}, time + 0.1);
+  const common::Point2 left = policy.goal()->position;
+  step = policy.update(common::Pose2{left.x(), left.y(), M_PI}, time + 0.1);
   EXPECT_EQ(types(step), (std::vector<Type>{Type::kGoalReached, Type::kPassagesReleased, Type::kFailedReleased,
                                             Type::kGoalChosen}));
   EXPECT_GT(first(step, Type::kPassagesReleased).count, 0u);
@@ -221,7 +221,7 @@ TEST(ExplorationPolicy, DoneOnlyAfterTheConfiguredPlansWithoutAGoal) {
   ExplorationPolicyOptions options;
   options.done_confirmations = 3;
   ExplorationPolicy policy(options);
-  const Pose2 pose{5.05, kCentreY, 0.0};
+  const common::Pose2 pose{5.05, kCentreY, 0.0};
   double time = 0.0;
   for (int plan = 1; plan < options.done_confirmations; ++plan) {
     policy.setMap(closedRoom());
@@ -261,15 +261,15 @@ TEST(ExplorationPolicy, KeepsItsGoalUnlessAnotherIsCheaperByTheHysteresis) {
   ExplorationPolicyOptions options;
   options.goal_hysteresis = 1.0;
   ExplorationPolicy policy(options);
-  const OccupancyGrid map = corridor(true, true);
+  const common::OccupancyGrid map = corridor(true, true);
   policy.setMap(map);
   // At x = 5.05 the right goal costs 3.4, the left one 3.5.
-  ExplorationStep step = policy.update(Pose2{5.05, kCentreY, 0.0}, 0.1);
+  ExplorationStep step = policy.update(common::Pose2{5.05, kCentreY, 0.0}, 0.1);
   ASSERT_TRUE(policy.goal());
   EXPECT_NEAR(policy.goal()->position.x(), kRightGoalX, 1e-9);
   // At x = 4.75 the left goal is 0.5 cheaper: the right one stays (replanned, not chosen anew).
   policy.setMap(map);
-  step = policy.update(Pose2{4.75, kCentreY, 0.0}, 0.2);
+  step = policy.update(common::Pose2{4.75, kCentreY, 0.0}, 0.2);
   EXPECT_TRUE(step.planned);
   EXPECT_TRUE(step.events.empty());
   ASSERT_TRUE(policy.goal());
@@ -277,7 +277,7 @@ TEST(ExplorationPolicy, KeepsItsGoalUnlessAnotherIsCheaperByTheHysteresis) {
   EXPECT_EQ(policy.follower().state(), FollowerState::kFollowing);
   // At x = 4.25 it is 1.5 cheaper: switched.
   policy.setMap(map);
-  step = policy.update(Pose2{4.25, kCentreY, 0.0}, 0.3);
+  step = policy.update(common::Pose2{4.25, kCentreY, 0.0}, 0.3);
   EXPECT_EQ(types(step), std::vector<Type>{Type::kGoalChosen});
   EXPECT_NEAR(first(step, Type::kGoalChosen).position.x(), kLeftGoalX, 1e-9);
 }
@@ -285,10 +285,10 @@ TEST(ExplorationPolicy, KeepsItsGoalUnlessAnotherIsCheaperByTheHysteresis) {
 TEST(ExplorationPolicy, AnUnusableMapKeepsTheOldOne) {
   ExplorationPolicy policy;
   policy.setMap(corridor(false, true));
-  policy.update(Pose2{5.05, kCentreY, 0.0}, 0.1);
+  policy.update(common::Pose2{5.05, kCentreY, 0.0}, 0.1);
   ASSERT_TRUE(policy.goal());
   policy.setUnusableMap("rotated map origins are not supported");
-  const ExplorationStep step = policy.update(Pose2{5.05, kCentreY, 0.0}, 0.2);
+  const ExplorationStep step = policy.update(common::Pose2{5.05, kCentreY, 0.0}, 0.2);
   ASSERT_EQ(types(step), std::vector<Type>{Type::kMapUnusable});
   EXPECT_EQ(step.events[0].message, "rotated map origins are not supported");
   EXPECT_FALSE(step.planned);
@@ -301,7 +301,7 @@ TEST(ExplorationPolicy, AHeldRobotDoesNotFailItsGoal) {
   ExplorationPolicyOptions options = quickFailures();
   ExplorationPolicy policy(options);
   policy.setMap(corridor(false, true));
-  const Pose2 pose{5.05, kCentreY, 0.0};
+  const common::Pose2 pose{5.05, kCentreY, 0.0};
   policy.update(pose, 0.1);
   // Held (a stale scan) for longer than the progress timeout: no failure, no recovery afterwards.
   policy.hold(0.2);
@@ -312,4 +312,4 @@ TEST(ExplorationPolicy, AHeldRobotDoesNotFailItsGoal) {
 }
 
 }  // namespace
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::exploration

@@ -8,37 +8,37 @@
 #include "hidden_rooms/exploration/frontier.h"
 #include "hidden_rooms/exploration/grid_planner.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::exploration {
 namespace {
 
 // 0.1 m cells, origin (0, 0); the whole grid unknown.
-OccupancyGrid unknownGrid(int cols, int rows) {
-  OccupancyGrid grid;
+common::OccupancyGrid unknownGrid(int cols, int rows) {
+  common::OccupancyGrid grid;
   grid.resolution = 0.1;
-  grid.cells = cv::Mat_<int8_t>(rows, cols, OccupancyGrid::kUnknown);
+  grid.cells = cv::Mat_<int8_t>(rows, cols, common::OccupancyGrid::kUnknown);
   return grid;
 }
 
 TEST(Frontier, EmptyMapHasNone) {
-  const FrontierMap frontiers = findFrontiers(OccupancyGrid());
+  const FrontierMap frontiers = findFrontiers(common::OccupancyGrid());
   EXPECT_TRUE(frontiers.frontiers.empty());
 }
 
 TEST(Frontier, FullyKnownRoomHasNone) {
-  OccupancyGrid grid = unknownGrid(30, 20);
-  grid.cells.setTo(OccupancyGrid::kOccupied);
-  grid.cells(cv::Rect(1, 1, 28, 18)).setTo(OccupancyGrid::kFree);
+  common::OccupancyGrid grid = unknownGrid(30, 20);
+  grid.cells.setTo(common::OccupancyGrid::kOccupied);
+  grid.cells(cv::Rect(1, 1, 28, 18)).setTo(common::OccupancyGrid::kFree);
   EXPECT_TRUE(findFrontiers(grid).frontiers.empty());
 }
 
 TEST(Frontier, GroupsTwoOpeningsAndDropsSmallOnes) {
   // A walled free room (cols 5..24, rows 5..14) in unknown space with two gaps in its walls: 6 cells on the left
   // wall and 2 cells on the right wall, which is below min_frontier_cells.
-  OccupancyGrid grid = unknownGrid(40, 20);
-  grid.cells(cv::Rect(4, 4, 22, 12)).setTo(OccupancyGrid::kOccupied);
-  grid.cells(cv::Rect(5, 5, 20, 10)).setTo(OccupancyGrid::kFree);
-  grid.cells(cv::Rect(4, 7, 1, 6)).setTo(OccupancyGrid::kFree);   // left gap: rows 7..12
-  grid.cells(cv::Rect(25, 9, 1, 2)).setTo(OccupancyGrid::kFree);  // right gap: rows 9..10
+  common::OccupancyGrid grid = unknownGrid(40, 20);
+  grid.cells(cv::Rect(4, 4, 22, 12)).setTo(common::OccupancyGrid::kOccupied);
+  grid.cells(cv::Rect(5, 5, 20, 10)).setTo(common::OccupancyGrid::kFree);
+  grid.cells(cv::Rect(4, 7, 1, 6)).setTo(common::OccupancyGrid::kFree);   // left gap: rows 7..12
+  grid.cells(cv::Rect(25, 9, 1, 2)).setTo(common::OccupancyGrid::kFree);  // right gap: rows 9..10
   FrontierOptions options;
   options.min_frontier_cells = 4;
   const FrontierMap frontiers = findFrontiers(grid, options);
@@ -59,9 +59,9 @@ TEST(Frontier, GroupsTwoOpeningsAndDropsSmallOnes) {
 }
 
 TEST(Frontier, IgnoresUnknownSpecksAndCountsTheGridEdgeAsUnknown) {
-  OccupancyGrid grid = unknownGrid(30, 20);
-  grid.cells.setTo(OccupancyGrid::kFree);
-  grid.cells(cv::Rect(10, 10, 2, 2)).setTo(OccupancyGrid::kUnknown);  // a 4-cell speck
+  common::OccupancyGrid grid = unknownGrid(30, 20);
+  grid.cells.setTo(common::OccupancyGrid::kFree);
+  grid.cells(cv::Rect(10, 10, 2, 2)).setTo(common::OccupancyGrid::kUnknown);  // a 4-cell speck
   FrontierOptions options;
   options.min_unknown_cells = 5;
   options.min_frontier_cells = 1;
@@ -77,9 +77,9 @@ TEST(Frontier, IgnoresUnknownSpecksAndCountsTheGridEdgeAsUnknown) {
 
 TEST(Frontier, UncertainCellsCountAsUnknown) {
   // A free room whose right part (cols 20..29) was seen too rarely to be free or occupied (value 40).
-  OccupancyGrid grid = unknownGrid(30, 20);
-  grid.cells.setTo(OccupancyGrid::kOccupied);
-  grid.cells(cv::Rect(1, 1, 28, 18)).setTo(OccupancyGrid::kFree);
+  common::OccupancyGrid grid = unknownGrid(30, 20);
+  grid.cells.setTo(common::OccupancyGrid::kOccupied);
+  grid.cells(cv::Rect(1, 1, 28, 18)).setTo(common::OccupancyGrid::kFree);
   grid.cells(cv::Rect(20, 1, 9, 18)).setTo(40);
   const FrontierMap frontiers = findFrontiers(grid);
   ASSERT_EQ(frontiers.frontiers.size(), 1u);
@@ -89,18 +89,18 @@ TEST(Frontier, UncertainCellsCountAsUnknown) {
 
 // A 10 m x 4 m free corridor (0.1 m cells) closed by walls, with unknown strips at both ends behind gaps:
 // frontier at the left end (x ~ 0.2) and at the right end (x ~ 9.8).
-OccupancyGrid corridorWithTwoEnds() {
-  OccupancyGrid grid = unknownGrid(100, 40);
-  grid.cells(cv::Rect(2, 0, 96, 40)).setTo(OccupancyGrid::kOccupied);
-  grid.cells(cv::Rect(2, 1, 96, 38)).setTo(OccupancyGrid::kFree);
+common::OccupancyGrid corridorWithTwoEnds() {
+  common::OccupancyGrid grid = unknownGrid(100, 40);
+  grid.cells(cv::Rect(2, 0, 96, 40)).setTo(common::OccupancyGrid::kOccupied);
+  grid.cells(cv::Rect(2, 1, 96, 38)).setTo(common::OccupancyGrid::kFree);
   return grid;
 }
 
 TEST(Frontier, NearestGoalIsTheCheaperEndAndSkipsTheBlacklist) {
-  const OccupancyGrid grid = corridorWithTwoEnds();
+  const common::OccupancyGrid grid = corridorWithTwoEnds();
   GridPlanner planner;
   planner.setMap(grid);
-  ASSERT_TRUE(planner.computeCostsFrom(Point2(7.0, 2.0)));
+  ASSERT_TRUE(planner.computeCostsFrom(common::Point2(7.0, 2.0)));
   const FrontierMap frontiers = findFrontiers(grid);
   ASSERT_EQ(frontiers.frontiers.size(), 2u);
   FrontierOptions options;
@@ -113,7 +113,7 @@ TEST(Frontier, NearestGoalIsTheCheaperEndAndSkipsTheBlacklist) {
 
   Blacklist blacklist;
   blacklist.radius = 3.0;
-  blacklist.points.push_back(Point2(9.8, 2.0));
+  blacklist.points.push_back(common::Point2(9.8, 2.0));
   const std::optional<FrontierGoal> other = nearestFrontierGoal(frontiers, planner, blacklist, options);
   ASSERT_TRUE(other.has_value());
   EXPECT_LT(other->position.x(), 1.0);
@@ -129,21 +129,21 @@ class BlacklistRelease : public ::testing::Test {
  protected:
   void SetUp() override {
     planner_.setMap(grid_);
-    ASSERT_TRUE(planner_.computeCostsFrom(Point2(7.0, 2.0)));
+    ASSERT_TRUE(planner_.computeCostsFrom(common::Point2(7.0, 2.0)));
     blacklist_.radius = 3.0;
   }
   std::optional<FrontierGoal> goal() const {
     return nearestFrontierGoal(frontiers_, planner_, blacklist_, FrontierOptions());
   }
-  const OccupancyGrid grid_ = corridorWithTwoEnds();
+  const common::OccupancyGrid grid_ = corridorWithTwoEnds();
   const FrontierMap frontiers_ = findFrontiers(grid_);
   GridPlanner planner_;
   Blacklist blacklist_;
 };
 
 TEST_F(BlacklistRelease, PlacesWhereTheRobotWasStuckAreTriedAgain) {
-  EXPECT_TRUE(blacklist_.add(Point2(9.8, 2.0), GoalOutcome::kRobotStuck));  // failed, the robot could not move
-  EXPECT_FALSE(blacklist_.add(Point2(0.2, 2.0), GoalOutcome::kReached));    // reached, its frontier still there
+  EXPECT_TRUE(blacklist_.add(common::Point2(9.8, 2.0), GoalOutcome::kRobotStuck));  // failed, the robot could not move
+  EXPECT_FALSE(blacklist_.add(common::Point2(0.2, 2.0), GoalOutcome::kReached));    // reached, its frontier still there
   EXPECT_FALSE(goal().has_value());
   EXPECT_EQ(blacklist_.releaseFailed(), 0u);
   EXPECT_EQ(blacklist_.releaseStuck(), 1u);
@@ -160,14 +160,14 @@ TEST_F(BlacklistRelease, PlacesWhereTheRobotWasStuckAreTriedAgain) {
 }
 
 TEST_F(BlacklistRelease, FailedPlacesGetOneSecondTry) {
-  EXPECT_FALSE(blacklist_.add(Point2(0.2, 2.0), GoalOutcome::kReached));
-  EXPECT_TRUE(blacklist_.add(Point2(9.8, 2.0), GoalOutcome::kFailed));
+  EXPECT_FALSE(blacklist_.add(common::Point2(0.2, 2.0), GoalOutcome::kReached));
+  EXPECT_TRUE(blacklist_.add(common::Point2(9.8, 2.0), GoalOutcome::kFailed));
   EXPECT_FALSE(goal().has_value());
   EXPECT_EQ(blacklist_.releaseStuck(), 0u);
   // The failed place is released, the reached one is not.
   EXPECT_EQ(blacklist_.releaseFailed(), 1u);
   ASSERT_EQ(blacklist_.points.size(), 1u);
-  EXPECT_EQ(blacklist_.points[0], Point2(0.2, 2.0));
+  EXPECT_EQ(blacklist_.points[0], common::Point2(0.2, 2.0));
   const std::optional<FrontierGoal> again = goal();
   ASSERT_TRUE(again.has_value());
   EXPECT_GT(again->position.x(), 9.0);
@@ -177,89 +177,90 @@ TEST_F(BlacklistRelease, FailedPlacesGetOneSecondTry) {
   EXPECT_EQ(blacklist_.releaseFailed(), 0u);
   EXPECT_FALSE(goal().has_value());
   // A failure elsewhere gets its own second try.
-  EXPECT_TRUE(blacklist_.add(Point2(5.0, 9.0), GoalOutcome::kFailed));
+  EXPECT_TRUE(blacklist_.add(common::Point2(5.0, 9.0), GoalOutcome::kFailed));
   EXPECT_EQ(blacklist_.releaseFailed(), 1u);
   EXPECT_EQ(blacklist_.points.size(), 2u);
 }
 
 // A straight path along y = 2 from x = 0 to x = 5 in 0.05 m steps.
-std::vector<Point2> straightPath() {
-  std::vector<Point2> path;
+std::vector<common::Point2> straightPath() {
+  std::vector<common::Point2> path;
   for (int i = 0; i <= 100; ++i) path.emplace_back(0.05 * i, 2.0);
   return path;
 }
 
 TEST(BlockedPassages, TwoFailuresFromOnePlaceBlockThePathAheadOfTheRobot) {
   BlockedPassages passages;  // 2 failures, same place within 0.5 m, stretch 0.25..1.0 m ahead
-  EXPECT_FALSE(passages.addFailure(Point2(2.0, 2.1), straightPath()));
+  EXPECT_FALSE(passages.addFailure(common::Point2(2.0, 2.1), straightPath()));
   EXPECT_TRUE(passages.blockedPoints().empty());
-  EXPECT_FALSE(passages.addFailure(Point2(4.0, 2.0), straightPath()));  // another place
+  EXPECT_FALSE(passages.addFailure(common::Point2(4.0, 2.0), straightPath()));  // another place
   EXPECT_TRUE(passages.blockedPoints().empty());
-  EXPECT_TRUE(passages.addFailure(Point2(2.3, 2.0), straightPath()));  // 0.3 m from the first, same way
+  EXPECT_TRUE(passages.addFailure(common::Point2(2.3, 2.0), straightPath()));  // 0.3 m from the first, same way
   ASSERT_FALSE(passages.blockedPoints().empty());
-  for (const Point2& point : passages.blockedPoints()) {
+  for (const common::Point2& point : passages.blockedPoints()) {
     EXPECT_GE(point.x(), 2.0 + 0.25 - 1e-9);  // ahead of the first failure's robot, not where it stood ...
     EXPECT_LE(point.x(), 2.3 + 1.0 + 1e-9);   // ... up to 1 m ahead of the second's
   }
   // The failure at x = 4 is still pending: one more there blocks its stretch too; a release opens all, once.
-  EXPECT_TRUE(passages.addFailure(Point2(4.1, 2.0), straightPath()));
+  EXPECT_TRUE(passages.addFailure(common::Point2(4.1, 2.0), straightPath()));
   EXPECT_GT(passages.releaseOnce(), 0u);
   EXPECT_TRUE(passages.blockedPoints().empty());
-  EXPECT_FALSE(passages.addFailure(Point2(1.0, 2.0), straightPath()));
-  EXPECT_TRUE(passages.addFailure(Point2(1.0, 2.0), straightPath()));
+  EXPECT_FALSE(passages.addFailure(common::Point2(1.0, 2.0), straightPath()));
+  EXPECT_TRUE(passages.addFailure(common::Point2(1.0, 2.0), straightPath()));
   EXPECT_EQ(passages.releaseOnce(), 0u);  // blocked for good now
   EXPECT_FALSE(passages.blockedPoints().empty());
 
   // Failures from one place in different directions: the robot is stuck there; what was blocked from there is
   // opened, and later failures there block nothing.
   BlockedPassages wedged;
-  std::vector<Point2> back = straightPath();
+  std::vector<common::Point2> back = straightPath();
   std::reverse(back.begin(), back.end());
-  EXPECT_FALSE(wedged.addFailure(Point2(2.0, 2.0), straightPath()));
-  EXPECT_TRUE(wedged.addFailure(Point2(2.1, 2.0), straightPath()));
+  EXPECT_FALSE(wedged.addFailure(common::Point2(2.0, 2.0), straightPath()));
+  EXPECT_TRUE(wedged.addFailure(common::Point2(2.1, 2.0), straightPath()));
   EXPECT_FALSE(wedged.blockedPoints().empty());
-  EXPECT_TRUE(wedged.addFailure(Point2(2.0, 2.0), back));  // the other way
+  EXPECT_TRUE(wedged.addFailure(common::Point2(2.0, 2.0), back));  // the other way
   EXPECT_TRUE(wedged.blockedPoints().empty());
-  for (int i = 0; i < 3; ++i) EXPECT_FALSE(wedged.addFailure(Point2(2.0, 2.1), straightPath()));
+  for (int i = 0; i < 3; ++i) EXPECT_FALSE(wedged.addFailure(common::Point2(2.0, 2.1), straightPath()));
   EXPECT_TRUE(wedged.blockedPoints().empty());
 
   BlockedPassagesOptions never;
   never.failures = 0;
   BlockedPassages off(never);
-  for (int i = 0; i < 3; ++i) EXPECT_FALSE(off.addFailure(Point2(2.0, 2.0), straightPath()));
+  for (int i = 0; i < 3; ++i) EXPECT_FALSE(off.addFailure(common::Point2(2.0, 2.0), straightPath()));
   EXPECT_TRUE(off.blockedPoints().empty());
   BlockedPassagesOptions bad;
   bad.skip = 2.0;  // beyond length
-  EXPECT_THROW(BlockedPassages{bad}, InputError);
+  EXPECT_THROW(BlockedPassages{bad}, common::InputError);
   bad = BlockedPassagesOptions();
   bad.radius = -0.1;
-  EXPECT_THROW(BlockedPassages{bad}, InputError);
+  EXPECT_THROW(BlockedPassages{bad}, common::InputError);
 }
 
 TEST(Frontier, UnreachableFrontierGivesNoGoal) {
   // A frontier in a second room that a wall separates from the robot's.
-  OccupancyGrid grid = corridorWithTwoEnds();
-  grid.cells(cv::Rect(50, 0, 2, 40)).setTo(OccupancyGrid::kOccupied);  // wall across at x = 5.0..5.2
-  grid.cells(cv::Rect(0, 0, 2, 40)).setTo(OccupancyGrid::kOccupied);   // left end closed: only the right frontier
+  common::OccupancyGrid grid = corridorWithTwoEnds();
+  grid.cells(cv::Rect(50, 0, 2, 40)).setTo(common::OccupancyGrid::kOccupied);  // wall across at x = 5.0..5.2
+  grid.cells(cv::Rect(0, 0, 2, 40))
+      .setTo(common::OccupancyGrid::kOccupied);  // left end closed: only the right frontier
   GridPlanner planner;
   planner.setMap(grid);
-  ASSERT_TRUE(planner.computeCostsFrom(Point2(2.0, 2.0)));
+  ASSERT_TRUE(planner.computeCostsFrom(common::Point2(2.0, 2.0)));
   const FrontierMap frontiers = findFrontiers(grid);
   ASSERT_EQ(frontiers.frontiers.size(), 1u);
   EXPECT_FALSE(nearestFrontierGoal(frontiers, planner, Blacklist(), FrontierOptions()).has_value());
   // From the other side it is reachable.
-  ASSERT_TRUE(planner.computeCostsFrom(Point2(8.0, 2.0)));
+  ASSERT_TRUE(planner.computeCostsFrom(common::Point2(8.0, 2.0)));
   EXPECT_TRUE(nearestFrontierGoal(frontiers, planner, Blacklist(), FrontierOptions()).has_value());
 }
 
 TEST(Frontier, GoalsKeepRobotRadiusButPathsPassNarrowDoors) {
   // Known room x = 0.2..4.0 with a wall at x = 4.0..4.2 and a 0.6 m door in it (6 free cells: its centre is 0.3 m
   // from the jambs); behind the door 1 m of known floor, then unknown space (a frontier at x = 5.15).
-  OccupancyGrid grid = unknownGrid(100, 40);
-  grid.cells(cv::Rect(2, 0, 50, 40)).setTo(OccupancyGrid::kOccupied);
-  grid.cells(cv::Rect(3, 1, 37, 38)).setTo(OccupancyGrid::kFree);
-  grid.cells(cv::Rect(40, 17, 2, 6)).setTo(OccupancyGrid::kFree);  // the door, rows 17..22
-  grid.cells(cv::Rect(42, 1, 10, 38)).setTo(OccupancyGrid::kFree);  // behind it, up to the frontier
+  common::OccupancyGrid grid = unknownGrid(100, 40);
+  grid.cells(cv::Rect(2, 0, 50, 40)).setTo(common::OccupancyGrid::kOccupied);
+  grid.cells(cv::Rect(3, 1, 37, 38)).setTo(common::OccupancyGrid::kFree);
+  grid.cells(cv::Rect(40, 17, 2, 6)).setTo(common::OccupancyGrid::kFree);   // the door, rows 17..22
+  grid.cells(cv::Rect(42, 1, 10, 38)).setTo(common::OccupancyGrid::kFree);  // behind it, up to the frontier
   const FrontierMap frontiers = findFrontiers(grid);
   ASSERT_EQ(frontiers.frontiers.size(), 1u);
 
@@ -268,7 +269,7 @@ TEST(Frontier, GoalsKeepRobotRadiusButPathsPassNarrowDoors) {
   planner_options.min_clearance = 0.25;
   GridPlanner planner(planner_options);
   planner.setMap(grid);
-  ASSERT_TRUE(planner.computeCostsFrom(Point2(2.0, 2.0)));
+  ASSERT_TRUE(planner.computeCostsFrom(common::Point2(2.0, 2.0)));
   const std::optional<FrontierGoal> goal = nearestFrontierGoal(frontiers, planner, Blacklist(), FrontierOptions());
   ASSERT_TRUE(goal.has_value());
   EXPECT_GT(goal->position.x(), 4.2);  // through the door
@@ -278,16 +279,16 @@ TEST(Frontier, GoalsKeepRobotRadiusButPathsPassNarrowDoors) {
   planner_options.min_clearance = planner_options.robot_radius;
   GridPlanner strict(planner_options);
   strict.setMap(grid);
-  ASSERT_TRUE(strict.computeCostsFrom(Point2(2.0, 2.0)));
+  ASSERT_TRUE(strict.computeCostsFrom(common::Point2(2.0, 2.0)));
   EXPECT_FALSE(nearestFrontierGoal(frontiers, strict, Blacklist(), FrontierOptions()).has_value());
 
   // A frontier in the door (the floor beyond it unknown): the cells within goal_reach (0.3 m here) of it are in
   // the door's narrow band, traversable and reachable but not roomy, so no goal there.
-  grid.cells(cv::Rect(42, 0, 10, 39)).setTo(OccupancyGrid::kUnknown);
+  grid.cells(cv::Rect(42, 0, 10, 39)).setTo(common::OccupancyGrid::kUnknown);
   planner_options.min_clearance = 0.25;
   GridPlanner narrow(planner_options);
   narrow.setMap(grid);
-  ASSERT_TRUE(narrow.computeCostsFrom(Point2(2.0, 2.0)));
+  ASSERT_TRUE(narrow.computeCostsFrom(common::Point2(2.0, 2.0)));
   FrontierOptions door_options;
   door_options.min_frontier_cells = 4;  // the door's 6 cells
   door_options.goal_reach = 0.3;
@@ -304,4 +305,4 @@ TEST(Frontier, GoalsKeepRobotRadiusButPathsPassNarrowDoors) {
 }
 
 }  // namespace
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::exploration

@@ -9,19 +9,19 @@
 #include "hidden_rooms/common/input_error.h"
 #include "hidden_rooms/exploration/path_follower.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::exploration {
 namespace {
 
 // A straight path along +x from (0, 0) to (length, 0), points every 0.05 m.
-std::vector<Point2> straightPath(double length) {
-  std::vector<Point2> path;
+std::vector<common::Point2> straightPath(double length) {
+  std::vector<common::Point2> path;
   for (double x = 0.0; x <= length + 1e-9; x += 0.05) path.emplace_back(x, 0.0);
   return path;
 }
 
 // A wall across the lane `distance` metres ahead of the robot's centre (base_link points).
-std::vector<Point2> wallAhead(double distance) {
-  std::vector<Point2> points;
+std::vector<common::Point2> wallAhead(double distance) {
+  std::vector<common::Point2> points;
   for (double y = -1.0; y <= 1.0; y += 0.02) points.emplace_back(distance, y);
   return points;
 }
@@ -29,7 +29,7 @@ std::vector<Point2> wallAhead(double distance) {
 TEST(PathFollower, DrivesStraightAlongAFreePath) {
   PathFollower follower;
   follower.setPath(straightPath(5.0), 0.0);
-  const FollowerStep step = follower.update(Pose2{0.0, 0.0, 0.0}, {}, 0.1);
+  const FollowerStep step = follower.update(common::Pose2{0.0, 0.0, 0.0}, {}, 0.1);
   EXPECT_EQ(step.state, FollowerState::kFollowing);
   EXPECT_NEAR(step.command.linear, follower.options().max_linear_velocity, 1e-9);
   EXPECT_NEAR(step.command.angular, 0.0, 1e-9);
@@ -40,7 +40,7 @@ TEST(PathFollower, SteersTowardsAPathBesideIt) {
   PathFollower follower;
   follower.setPath(straightPath(5.0), 0.0);
   // The robot 0.3 m right of the path (y = -0.3), facing along it: pure pursuit turns left (positive).
-  const FollowerStep step = follower.update(Pose2{1.0, -0.3, 0.0}, {}, 0.1);
+  const FollowerStep step = follower.update(common::Pose2{1.0, -0.3, 0.0}, {}, 0.1);
   EXPECT_GT(step.command.linear, 0.0);
   EXPECT_GT(step.command.angular, 0.0);
   EXPECT_LE(step.command.angular, follower.options().max_angular_velocity);
@@ -49,7 +49,7 @@ TEST(PathFollower, SteersTowardsAPathBesideIt) {
 TEST(PathFollower, TurnsInPlaceWhenThePathIsBehind) {
   PathFollower follower;
   follower.setPath(straightPath(5.0), 0.0);
-  const FollowerStep step = follower.update(Pose2{0.0, 0.0, M_PI}, {}, 0.1);
+  const FollowerStep step = follower.update(common::Pose2{0.0, 0.0, M_PI}, {}, 0.1);
   EXPECT_EQ(step.command.linear, 0.0);
   EXPECT_NE(step.command.angular, 0.0);
 }
@@ -60,24 +60,24 @@ TEST(PathFollower, TurningInPlaceMovesAwayFromAWallTheCornersWouldHit) {
   follower.setPath(straightPath(5.0), 0.0);
   // The path is behind (turn in place); a wall 0.08 m from the left side (outside the lane, inside the circle
   // the turning footprint sweeps), along the front half.
-  std::vector<Point2> wall;
+  std::vector<common::Point2> wall;
   for (double x = 0.02; x <= 0.3; x += 0.02) wall.emplace_back(x, 0.5 * options.footprint_width + 0.08);
-  FollowerStep step = follower.update(Pose2{0.0, 0.0, M_PI}, wall, 0.1);
+  FollowerStep step = follower.update(common::Pose2{0.0, 0.0, M_PI}, wall, 0.1);
   EXPECT_NE(step.command.angular, 0.0);
   EXPECT_NEAR(step.command.linear, -options.creep_velocity, 1e-9);  // backs away from the front corner's wall
   // The same wall along the rear half: creeps forward while turning.
-  for (Point2& point : wall) point.x() = -point.x();
-  step = follower.update(Pose2{0.0, 0.0, M_PI}, wall, 0.2);
+  for (common::Point2& point : wall) point.x() = -point.x();
+  step = follower.update(common::Pose2{0.0, 0.0, M_PI}, wall, 0.2);
   EXPECT_NEAR(step.command.linear, options.creep_velocity, 1e-9);
   EXPECT_NE(step.command.angular, 0.0);
   // Walls along both halves (a doorway): leaves straight ahead first.
-  std::vector<Point2> both = wall;
-  for (const Point2& point : wall) both.emplace_back(-point.x(), point.y());
-  step = follower.update(Pose2{0.0, 0.0, M_PI}, both, 0.3);
+  std::vector<common::Point2> both = wall;
+  for (const common::Point2& point : wall) both.emplace_back(-point.x(), point.y());
+  step = follower.update(common::Pose2{0.0, 0.0, M_PI}, both, 0.3);
   EXPECT_NEAR(step.command.linear, options.creep_velocity, 1e-9);
   EXPECT_EQ(step.command.angular, 0.0);
   // Nothing near: turns on the spot.
-  step = follower.update(Pose2{0.0, 0.0, M_PI}, {}, 0.4);
+  step = follower.update(common::Pose2{0.0, 0.0, M_PI}, {}, 0.4);
   EXPECT_EQ(step.command.linear, 0.0);
   EXPECT_NE(step.command.angular, 0.0);
 }
@@ -88,15 +88,15 @@ TEST(PathFollower, SteersAwayFromADoorFrameTheArcWouldTouch) {
   follower.setPath(straightPath(5.0), 0.0);
   // A post 0.5 m ahead, 0.03 m beside the left side of the footprint's straight sweep (within side_margin; far
   // enough ahead for no speed cap): the robot turns right (negative) and keeps going.
-  const std::vector<Point2> post{{0.313 + 0.5, 0.5 * options.footprint_width + 0.03}};
-  const FollowerStep step = follower.update(Pose2{}, post, 0.1);
+  const std::vector<common::Point2> post{{0.313 + 0.5, 0.5 * options.footprint_width + 0.03}};
+  const FollowerStep step = follower.update(common::Pose2{}, post, 0.1);
   EXPECT_GT(step.command.linear, 0.0);
   EXPECT_LT(step.command.angular, 0.0);
   // Without the check it drives straight on.
   options.arc_horizon = 0.0;
   PathFollower unchecked(options);
   unchecked.setPath(straightPath(5.0), 0.0);
-  EXPECT_NEAR(unchecked.update(Pose2{}, post, 0.1).command.angular, 0.0, 1e-9);
+  EXPECT_NEAR(unchecked.update(common::Pose2{}, post, 0.1).command.angular, 0.0, 1e-9);
 }
 
 TEST(PathFollower, TurnsSlowlyInADoorway) {
@@ -104,12 +104,12 @@ TEST(PathFollower, TurnsSlowlyInADoorway) {
   PathFollower follower(options);
   follower.setPath(straightPath(5.0), 0.0);
   // The robot 0.3 m right of the path, facing along it: pure pursuit turns left fast in the open ...
-  const double open_turn = follower.update(Pose2{1.0, -0.3, 0.0}, {}, 0.1).command.angular;
+  const double open_turn = follower.update(common::Pose2{1.0, -0.3, 0.0}, {}, 0.1).command.angular;
   EXPECT_GT(open_turn, options.doorway_angular_velocity);
   // ... but between door frames 0.15 m beside both sides only at the doorway's rate.
   const double side = 0.5 * options.footprint_width + 0.15;
-  const std::vector<Point2> frames{{0.0, side}, {-0.2, side}, {0.0, -side}, {-0.2, -side}};
-  const FollowerStep step = follower.update(Pose2{1.0, -0.3, 0.0}, frames, 0.2);
+  const std::vector<common::Point2> frames{{0.0, side}, {-0.2, side}, {0.0, -side}, {-0.2, -side}};
+  const FollowerStep step = follower.update(common::Pose2{1.0, -0.3, 0.0}, frames, 0.2);
   EXPECT_GT(step.command.linear, 0.0);
   EXPECT_NEAR(step.command.angular, options.doorway_angular_velocity, 1e-9);
 }
@@ -120,16 +120,17 @@ TEST(PathFollower, SlowsDownAndStopsInFrontOfAnObstacle) {
   follower.setPath(straightPath(5.0), 0.0);
   const double half_length = 0.5 * options.footprint_length;
   // Free space 0.2 m ahead of the front: capped at sqrt(2 a (0.2 - stop_distance)).
-  FollowerStep step = follower.update(Pose2{}, wallAhead(half_length + 0.2), 0.1);
+  FollowerStep step = follower.update(common::Pose2{}, wallAhead(half_length + 0.2), 0.1);
   EXPECT_NEAR(step.front_clearance, 0.2, 1e-9);
   EXPECT_NEAR(step.command.linear, std::sqrt(2.0 * options.deceleration * (0.2 - options.stop_distance)), 1e-9);
   // Closer than stop_distance: no forward motion.
-  step = follower.update(Pose2{}, wallAhead(half_length + 0.5 * options.stop_distance), 0.2);
+  step = follower.update(common::Pose2{}, wallAhead(half_length + 0.5 * options.stop_distance), 0.2);
   EXPECT_EQ(step.command.linear, 0.0);
   EXPECT_EQ(step.state, FollowerState::kFollowing);
   // Walls beside the lane (a door frame 0.2 m from each side) do not slow it down.
-  std::vector<Point2> door{{0.5, 0.5 * options.footprint_width + 0.2}, {0.5, -0.5 * options.footprint_width - 0.2}};
-  step = follower.update(Pose2{}, door, 0.3);
+  std::vector<common::Point2> door{{0.5, 0.5 * options.footprint_width + 0.2},
+                                   {0.5, -0.5 * options.footprint_width - 0.2}};
+  step = follower.update(common::Pose2{}, door, 0.3);
   EXPECT_NEAR(step.command.linear, options.max_linear_velocity, 1e-9);
 }
 
@@ -137,7 +138,7 @@ TEST(PathFollower, IgnoresNonFiniteObstaclePoints) {
   PathFollower follower;
   follower.setPath(straightPath(5.0), 0.0);
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  const FollowerStep step = follower.update(Pose2{}, {Point2(nan, 0.0), Point2(0.5, nan)}, 0.1);
+  const FollowerStep step = follower.update(common::Pose2{}, {common::Point2(nan, 0.0), common::Point2(0.5, nan)}, 0.1);
   EXPECT_TRUE(std::isinf(step.front_clearance));
   EXPECT_GT(step.command.linear, 0.0);
 }
@@ -145,11 +146,11 @@ TEST(PathFollower, IgnoresNonFiniteObstaclePoints) {
 TEST(PathFollower, ReachesTheGoal) {
   PathFollower follower;
   follower.setPath(straightPath(2.0), 0.0);
-  EXPECT_EQ(follower.update(Pose2{1.0, 0.0, 0.0}, {}, 1.0).state, FollowerState::kFollowing);
-  const FollowerStep step = follower.update(Pose2{1.8, 0.05, 0.0}, {}, 2.0);
+  EXPECT_EQ(follower.update(common::Pose2{1.0, 0.0, 0.0}, {}, 1.0).state, FollowerState::kFollowing);
+  const FollowerStep step = follower.update(common::Pose2{1.8, 0.05, 0.0}, {}, 2.0);
   EXPECT_EQ(step.state, FollowerState::kGoalReached);
   EXPECT_EQ(step.command.linear, 0.0);
-  EXPECT_EQ(follower.update(Pose2{1.8, 0.05, 0.0}, {}, 2.1).state, FollowerState::kGoalReached);  // stays
+  EXPECT_EQ(follower.update(common::Pose2{1.8, 0.05, 0.0}, {}, 2.1).state, FollowerState::kGoalReached);  // stays
   follower.setPath({}, 3.0);
   EXPECT_EQ(follower.state(), FollowerState::kIdle);
 }
@@ -160,8 +161,8 @@ TEST(PathFollower, StallTriggersRecoveryAndTooManyFail) {
   PathFollower follower(options);
   follower.setPath(straightPath(5.0), 0.0);
   // Blocked: a wall just ahead, and the robot never moves.
-  const std::vector<Point2> wall = wallAhead(0.5 * options.footprint_length + 0.05);
-  const Pose2 stuck{0.5, 0.0, 0.0};
+  const std::vector<common::Point2> wall = wallAhead(0.5 * options.footprint_length + 0.05);
+  const common::Pose2 stuck{0.5, 0.0, 0.0};
   double time = 0.0;
   FollowerStep step;
   for (; time < options.stall_timeout - 0.05; time += 0.1) {
@@ -204,7 +205,7 @@ TEST(PathFollower, FailsWithoutProgressEvenWhenMoving) {
   FollowerStep step;
   double time = 0.0;
   for (int i = 0; step.state != FollowerState::kFailed && time < 10.0; ++i, time += 0.1)
-    step = follower.update(Pose2{0.0, 0.0, i % 2 == 0 ? 0.3 : -0.3}, {}, time);
+    step = follower.update(common::Pose2{0.0, 0.0, i % 2 == 0 ? 0.3 : -0.3}, {}, time);
   EXPECT_EQ(step.state, FollowerState::kFailed);
   EXPECT_NEAR(time, options.progress_timeout, 0.25);
 }
@@ -214,11 +215,11 @@ TEST(PathFollower, HeldTimeCountsNeitherForProgressNorForTheStallWatch) {
   PathFollower held(options), not_held(options);
   for (PathFollower* follower : {&held, &not_held}) {
     follower->setPath(straightPath(5.0), 0.0);
-    follower->update(Pose2{0.0, 0.0, 0.0}, {}, 0.1);
-    follower->update(Pose2{0.4, 0.0, 0.0}, {}, 1.0);  // progress
+    follower->update(common::Pose2{0.0, 0.0, 0.0}, {}, 0.1);
+    follower->update(common::Pose2{0.4, 0.0, 0.0}, {}, 1.0);  // progress
   }
   // Stopped from outside for 30 s (no map): the node holds the follower on every tick.
-  const Pose2 still{0.4, 0.0, 0.0};
+  const common::Pose2 still{0.4, 0.0, 0.0};
   for (double time = 1.1; time < 31.0; time += 0.1) held.hold(time);
   FollowerStep step = held.update(still, {}, 31.0);
   EXPECT_EQ(step.state, FollowerState::kFollowing);
@@ -242,8 +243,8 @@ TEST(PathFollower, AHeldRecoveryGoesOnForTheRestOfItsTime) {
   PathFollowerOptions options;  // backoff_time 1.5 s
   PathFollower follower(options);
   follower.setPath(straightPath(5.0), 0.0);
-  const std::vector<Point2> wall = wallAhead(0.5 * options.footprint_length + 0.05);
-  const Pose2 stuck{0.5, 0.0, 0.0};
+  const std::vector<common::Point2> wall = wallAhead(0.5 * options.footprint_length + 0.05);
+  const common::Pose2 stuck{0.5, 0.0, 0.0};
   FollowerStep step;
   double time = 0.0;
   for (; step.state != FollowerState::kBackingOff && time < 10.0; time += 0.1) step = follower.update(stuck, wall, time);
@@ -263,13 +264,13 @@ TEST(PathFollower, AHeldRecoveryGoesOnForTheRestOfItsTime) {
 TEST(PathFollower, CountsTheRecoveriesThatMovedNothing) {
   PathFollowerOptions options;
   options.max_recoveries = 2;
-  const std::vector<Point2> wall = wallAhead(0.5 * options.footprint_length + 0.05);
+  const std::vector<common::Point2> wall = wallAhead(0.5 * options.footprint_length + 0.05);
   {  // Pinned: no command moves the robot; both recoveries moved nothing.
     PathFollower follower(options);
     follower.setPath(straightPath(5.0), 0.0);
     FollowerStep step;
     for (double time = 0.0; step.state != FollowerState::kFailed && time < 60.0; time += 0.1)
-      step = follower.update(Pose2{0.5, 0.0, 0.0}, wall, time);
+      step = follower.update(common::Pose2{0.5, 0.0, 0.0}, wall, time);
     EXPECT_EQ(step.state, FollowerState::kFailed);
     EXPECT_EQ(follower.recoveries(), 2);
     EXPECT_EQ(follower.recoveriesWithoutMotion(), 2);
@@ -277,7 +278,7 @@ TEST(PathFollower, CountsTheRecoveriesThatMovedNothing) {
   {  // Blocked ahead but free to move: the robot follows the recovery's commands, which counts as motion.
     PathFollower follower(options);
     follower.setPath(straightPath(5.0), 0.0);
-    Pose2 pose{0.5, 0.0, 0.0};
+    common::Pose2 pose{0.5, 0.0, 0.0};
     FollowerStep step;
     for (double time = 0.0; follower.recoveries() < 1 || step.state != FollowerState::kFollowing; time += 0.1) {
       ASSERT_LT(time, 30.0);
@@ -297,9 +298,9 @@ TEST(PathFollower, ARecoveryThatMovedNothingMakesTheNextTurnTheOtherWay) {
   PathFollowerOptions options;
   options.max_recoveries = 2;
   // The wall ahead leans to the left: the freer side is the right (a clockwise turn).
-  std::vector<Point2> wall = wallAhead(0.5 * options.footprint_length + 0.05);
+  std::vector<common::Point2> wall = wallAhead(0.5 * options.footprint_length + 0.05);
   for (double x = 0.0; x < 0.5; x += 0.02) wall.emplace_back(x, 0.35);
-  const Pose2 pinned{0.5, 0.0, 0.0};
+  const common::Pose2 pinned{0.5, 0.0, 0.0};
   // The turn direction of every recovery until the goal fails.
   const auto recovery_turns = [&](PathFollower* follower, double* time) {
     std::vector<double> turns;
@@ -321,7 +322,7 @@ TEST(PathFollower, ARecoveryThatMovedNothingMakesTheNextTurnTheOtherWay) {
   EXPECT_EQ(recovery_turns(&follower, &time), (std::vector<double>{-1.0, 1.0}));
   // A robot that follows the commands: every recovery moves it, so the laser's side every time.
   PathFollower free_follower(options);
-  Pose2 pose = pinned;
+  common::Pose2 pose = pinned;
   time = 0.0;
   free_follower.setPath(straightPath(5.0), time);
   std::vector<double> turns;
@@ -337,15 +338,15 @@ TEST(PathFollower, ARecoveryThatMovedNothingMakesTheNextTurnTheOtherWay) {
 }
 
 TEST(PathFollower, ObstaclePointsSkipInvalidReturnsAndApplyTheLaserPose) {
-  RangeScan scan;
+  common::RangeScan scan;
   scan.angle_min = -M_PI / 2;
   scan.angle_increment = M_PI / 2;
   scan.range_min = 0.05;
   scan.range_max = 30.0;
   scan.ranges = {1.0f, std::numeric_limits<float>::quiet_NaN(), 30.0f, 0.01f, 2.0f};  // beams at -90, 0, 90, 180, 270 deg
-  scan.sensor_pose = Pose2{0.2, 0.0, 0.0};
+  scan.sensor_pose = common::Pose2{0.2, 0.0, 0.0};
   int skipped = 0;
-  const std::vector<Point2> points = obstaclePoints(scan, &skipped);
+  const std::vector<common::Point2> points = obstaclePoints(scan, &skipped);
   EXPECT_EQ(skipped, 3);
   ASSERT_EQ(points.size(), 2u);
   EXPECT_NEAR(points[0].x(), 0.2, 1e-9);
@@ -359,7 +360,7 @@ TEST(PathFollower, WallsBesideTheFootprintLeaveItsLaneOpen) {
   const double half_length = 0.5 * options.footprint_length, half_width = 0.5 * options.footprint_width;
   // Walls 0.03 m beside both sides (within side_margin) along the whole footprint: the robot may drive on and back
   // off straight.
-  std::vector<Point2> tunnel;
+  std::vector<common::Point2> tunnel;
   for (double x = -half_length; x <= half_length + 1e-9; x += 0.02) {
     tunnel.emplace_back(x, half_width + 0.03);
     tunnel.emplace_back(x, -half_width - 0.03);
@@ -379,25 +380,26 @@ TEST(PathFollower, WallsBesideTheFootprintLeaveItsLaneOpen) {
 
 TEST(PathFollower, ObstacleMemoryKeepsRecentPointsInTheRobotFrame) {
   ObstacleMemory memory(1.0);
-  memory.add({Point2(1.0, 0.0)}, Pose2{0.0, 0.0, 0.0}, 0.0);        // a point at map (1, 0)
-  memory.add({Point2(0.0, 1.0)}, Pose2{0.0, 0.0, M_PI / 2}, 0.5);   // map (-1, 0)
-  std::vector<Point2> points = memory.points(Pose2{1.0, 0.0, M_PI});  // robot on the first point, facing -x
+  memory.add({common::Point2(1.0, 0.0)}, common::Pose2{0.0, 0.0, 0.0}, 0.0);       // a point at map (1, 0)
+  memory.add({common::Point2(0.0, 1.0)}, common::Pose2{0.0, 0.0, M_PI / 2}, 0.5);  // map (-1, 0)
+  std::vector<common::Point2> points =
+      memory.points(common::Pose2{1.0, 0.0, M_PI});  // robot on the first point, facing -x
   ASSERT_EQ(points.size(), 2u);
   EXPECT_NEAR(points[0].norm(), 0.0, 1e-9);
   EXPECT_NEAR(points[1].x(), 2.0, 1e-9);  // map (-1, 0) is 2 m ahead
   EXPECT_NEAR(points[1].y(), 0.0, 1e-9);
-  memory.add({}, Pose2{}, 1.2);  // the first scan is now too old
-  EXPECT_EQ(memory.points(Pose2{}).size(), 1u);
+  memory.add({}, common::Pose2{}, 1.2);  // the first scan is now too old
+  EXPECT_EQ(memory.points(common::Pose2{}).size(), 1u);
 }
 
 TEST(PathFollower, RejectsBadOptions) {
   PathFollowerOptions options;
   options.max_linear_velocity = -1.0;
-  EXPECT_THROW(PathFollower{options}, InputError);
+  EXPECT_THROW(PathFollower{options}, common::InputError);
   options = PathFollowerOptions();
   options.lookahead = std::numeric_limits<double>::infinity();
-  EXPECT_THROW(PathFollower{options}, InputError);
+  EXPECT_THROW(PathFollower{options}, common::InputError);
 }
 
 }  // namespace
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::exploration

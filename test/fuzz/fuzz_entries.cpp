@@ -36,14 +36,14 @@ template <typename Read>
 void refusingOnlyWithInputError(Read read) {
   try {
     read();
-  } catch (const InputError&) {
+  } catch (const common::InputError&) {
   }
 }
 
 }  // namespace
 
 void environmentXml(const uint8_t* data, size_t size) {
-  refusingOnlyWithInputError([&] { parseEnvironment(text(data, size), "fuzz.xml"); });
+  refusingOnlyWithInputError([&] { world::parseEnvironment(text(data, size), "fuzz.xml"); });
 }
 
 void mapYaml(const uint8_t* data, size_t size) {
@@ -52,31 +52,33 @@ void mapYaml(const uint8_t* data, size_t size) {
   const std::string yaml = bytes.substr(0, split);
   scratchFile("map.img", split == std::string::npos ? std::string() : bytes.substr(split + 1));
   const std::string path = scratchFile("map.yaml", yaml);
-  refusingOnlyWithInputError([&] { loadMap(path); });
+  refusingOnlyWithInputError([&] { common::loadMap(path); });
 }
 
 void image(const uint8_t* data, size_t size) {
   const std::string path = scratchFile("image.bin", text(data, size));
-  refusingOnlyWithInputError([&] { readImage(path); });
+  refusingOnlyWithInputError([&] { common::readImage(path); });
 }
 
 void doorsYaml(const uint8_t* data, size_t size) {
-  refusingOnlyWithInputError([&] { parseDoors(text(data, size), "fuzz_doors.yaml"); });
+  refusingOnlyWithInputError([&] { common::parseDoors(text(data, size), "fuzz_doors.yaml"); });
 }
 
 void parameterFile(const uint8_t* data, size_t size) {
   const std::string path = scratchFile("params.yaml", text(data, size));
-  refusingOnlyWithInputError([&] { resolveParameters(*makeRoomPredictor("default"), loadParameterFile(path)); });
+  refusingOnlyWithInputError([&] {
+    prediction::resolveParameters(*prediction::makeRoomPredictor("default"), prediction::loadParameterFile(path));
+  });
 }
 
 void poseLog(const uint8_t* data, size_t size) {
-  refusingOnlyWithInputError([&] { parsePoseLog(text(data, size), "fuzz.log"); });
+  refusingOnlyWithInputError([&] { common::parsePoseLog(text(data, size), "fuzz.log"); });
 }
 
 void octomap(const uint8_t* data, size_t size) {
   if (size == 0) return;
   const std::string path = scratchFile(data[0] % 2 ? "tree.ot" : "tree.bt", text(data + 1, size - 1));
-  refusingOnlyWithInputError([&] { sliceOctomap(path, SliceOptions()); });
+  refusingOnlyWithInputError([&] { map3d::sliceOctomap(path, map3d::SliceOptions()); });
 }
 
 const std::vector<Target>& targets() {

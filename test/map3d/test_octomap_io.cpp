@@ -16,22 +16,22 @@
 #include "hidden_rooms/prediction/room_predictor.h"
 #include "test_util.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::map3d {
 namespace {
 
 using testing::inputErrorMessage;
 
 // The map cut to the bounding box of its known cells (what a slice of its extrusion covers).
-OccupancyGrid cropToKnown(const OccupancyGrid& map) {
-  const cv::Rect box = cv::boundingRect(map.cells != OccupancyGrid::kUnknown);
-  OccupancyGrid cropped;
+common::OccupancyGrid cropToKnown(const common::OccupancyGrid& map) {
+  const cv::Rect box = cv::boundingRect(map.cells != common::OccupancyGrid::kUnknown);
+  common::OccupancyGrid cropped;
   cropped.resolution = map.resolution;
   cropped.cells = map.cells(box).clone();
-  cropped.origin = map.origin + map.resolution * Point2(box.x, map.height() - box.y - box.height);
+  cropped.origin = map.origin + map.resolution * common::Point2(box.x, map.height() - box.y - box.height);
   return cropped;
 }
 
-void expectSameMap(const OccupancyGrid& actual, const OccupancyGrid& expected) {
+void expectSameMap(const common::OccupancyGrid& actual, const common::OccupancyGrid& expected) {
   ASSERT_EQ(actual.cells.size(), expected.cells.size());
   EXPECT_NEAR(actual.resolution, expected.resolution, 1e-9);
   EXPECT_NEAR((actual.origin - expected.origin).norm(), 0.0, 1e-4);
@@ -39,11 +39,11 @@ void expectSameMap(const OccupancyGrid& actual, const OccupancyGrid& expected) {
 }
 
 TEST(OctomapIo, ExportThenSliceGivesTheMapBack) {
-  OccupancyGrid map;
-  DoorsFile doors;
+  common::OccupancyGrid map;
+  common::DoorsFile doors;
   cv::Mat1w truth;
   testing::syntheticHiddenRoomA(&map, &doors, &truth);
-  const OccupancyGrid known = cropToKnown(map);
+  const common::OccupancyGrid known = cropToKnown(map);
   const std::string dir = testing::makeTempDir("octomap_round_trip");
   for (const std::string name : {"map.bt", "map.ot"}) {
     exportOctomap(map, cv::Mat1w(), ExtrusionOptions(), dir + "/" + name);
@@ -54,19 +54,19 @@ TEST(OctomapIo, ExportThenSliceGivesTheMapBack) {
   SliceOptions above;
   above.z_min = 3.0;
   above.z_max = 4.0;
-  const OccupancyGrid empty = sliceOctomap(dir + "/map.bt", above);
-  EXPECT_EQ(cv::countNonZero(empty.cells != OccupancyGrid::kUnknown), 0);
+  const common::OccupancyGrid empty = sliceOctomap(dir + "/map.bt", above);
+  EXPECT_EQ(cv::countNonZero(empty.cells != common::OccupancyGrid::kUnknown), 0);
 }
 
 TEST(OctomapIo, ColoursThePredictedRoomsInTheColorOcTree) {
-  OccupancyGrid map;
-  DoorsFile doors;
+  common::OccupancyGrid map;
+  common::DoorsFile doors;
   cv::Mat1w truth;
   testing::syntheticHiddenRoomA(&map, &doors, &truth);
-  PredictionRequest request{map, doors, {}, ""};
-  const PredictionResult result = makeRoomPredictor("default")->predict(request);
-  const OccupancyGrid completed = insertRooms(map, doors, result.rooms);
-  const cv::Mat1w labels = roomLabels(map, doors, result.rooms);
+  prediction::PredictionRequest request{map, doors, {}, ""};
+  const prediction::PredictionResult result = prediction::makeRoomPredictor("default")->predict(request);
+  const common::OccupancyGrid completed = prediction::insertRooms(map, doors, result.rooms);
+  const cv::Mat1w labels = prediction::roomLabels(map, doors, result.rooms);
   const std::string path = testing::makeTempDir("octomap_colours") + "/completed.ot";
   exportOctomap(completed, labels, ExtrusionOptions(), path);
 
@@ -75,15 +75,15 @@ TEST(OctomapIo, ColoursThePredictedRoomsInTheColorOcTree) {
   ASSERT_NE(tree, nullptr);
   cv::Point room_cell;
   cv::minMaxLoc(labels, nullptr, nullptr, nullptr, &room_cell);
-  const Point2 centre = completed.cellCentre(room_cell.x, room_cell.y);
+  const common::Point2 centre = completed.cellCentre(room_cell.x, room_cell.y);
   const octomap::ColorOcTreeNode* node = tree->search(centre.x(), centre.y(), 1.0);
   ASSERT_NE(node, nullptr);
   EXPECT_FALSE(tree->isNodeOccupied(node));
-  const cv::Vec3b colour = roomColour(1);
+  const cv::Vec3b colour = common::roomColour(1);
   EXPECT_EQ(node->getColor(), octomap::ColorOcTreeNode::Color(colour[2], colour[1], colour[0]));
   // Outside the room: grey.
   int corridor_col = 0, corridor_row = 0;
-  ASSERT_TRUE(completed.cellOf(Point2(5.0, 1.0), &corridor_col, &corridor_row));
+  ASSERT_TRUE(completed.cellOf(common::Point2(5.0, 1.0), &corridor_col, &corridor_row));
   ASSERT_EQ(labels(corridor_row, corridor_col), 0);
   const octomap::ColorOcTreeNode* corridor = tree->search(5.0, 1.0, 1.0);
   ASSERT_NE(corridor, nullptr);
@@ -91,43 +91,43 @@ TEST(OctomapIo, ColoursThePredictedRoomsInTheColorOcTree) {
 }
 
 TEST(OctomapIo, CoarserVoxelsKeepTheWalls) {
-  OccupancyGrid map;
+  common::OccupancyGrid map;
   map.resolution = 0.05;
-  map.cells = cv::Mat_<int8_t>(40, 40, OccupancyGrid::kFree);
-  map.cells.col(21).setTo(OccupancyGrid::kOccupied);  // a one-cell wall
+  map.cells = cv::Mat_<int8_t>(40, 40, common::OccupancyGrid::kFree);
+  map.cells.col(21).setTo(common::OccupancyGrid::kOccupied);  // a one-cell wall
   const std::string path = testing::makeTempDir("octomap_coarse") + "/map.bt";
   ExtrusionOptions extrusion;
   extrusion.resolution = 0.1;
   exportOctomap(map, cv::Mat1w(), extrusion, path);
-  const OccupancyGrid sliced = sliceOctomap(path, SliceOptions());
+  const common::OccupancyGrid sliced = sliceOctomap(path, SliceOptions());
   ASSERT_EQ(sliced.width(), 20);
   EXPECT_DOUBLE_EQ(sliced.resolution, 0.1);
-  EXPECT_EQ(cv::countNonZero(sliced.cells == OccupancyGrid::kOccupied), 20);  // the wall's column survives
-  EXPECT_EQ(cv::countNonZero(sliced.cells.col(10) == OccupancyGrid::kOccupied), 20);
+  EXPECT_EQ(cv::countNonZero(sliced.cells == common::OccupancyGrid::kOccupied), 20);  // the wall's column survives
+  EXPECT_EQ(cv::countNonZero(sliced.cells.col(10) == common::OccupancyGrid::kOccupied), 20);
 }
 
 TEST(OctomapIo, PredictionOnASlicedMapEqualsPredictionOnTheMap) {
   HIDDEN_ROOMS_REQUIRE_SHARED_DATA();
   const std::string case_dir = testing::sharedDir() + "/data/closed_door_benchmark/office1_fs/15_doors";
-  const OccupancyGrid known = cropToKnown(loadMap(case_dir + "/map.yaml"));
-  const DoorsFile doors = loadDoors(case_dir + "/doors.yaml");
+  const common::OccupancyGrid known = cropToKnown(common::loadMap(case_dir + "/map.yaml"));
+  const common::DoorsFile doors = common::loadDoors(case_dir + "/doors.yaml");
   const std::string path = testing::makeTempDir("octomap_predict") + "/map.bt";
   exportOctomap(known, cv::Mat1w(), ExtrusionOptions(), path);
-  const OccupancyGrid sliced = sliceOctomap(path, SliceOptions());
+  const common::OccupancyGrid sliced = sliceOctomap(path, SliceOptions());
   expectSameMap(sliced, known);
-  const auto predictor = makeRoomPredictor("default");
-  const PredictionResult on_map = predictor->predict({known, doors, {}, ""});
-  const PredictionResult on_slice = predictor->predict({sliced, doors, {}, ""});
-  const cv::Mat1w labels_map = roomLabels(known, doors, on_map.rooms);
-  const cv::Mat1w labels_slice = roomLabels(sliced, doors, on_slice.rooms);
+  const auto predictor = prediction::makeRoomPredictor("default");
+  const prediction::PredictionResult on_map = predictor->predict({known, doors, {}, ""});
+  const prediction::PredictionResult on_slice = predictor->predict({sliced, doors, {}, ""});
+  const cv::Mat1w labels_map = prediction::roomLabels(known, doors, on_map.rooms);
+  const cv::Mat1w labels_slice = prediction::roomLabels(sliced, doors, on_slice.rooms);
   EXPECT_GT(cv::countNonZero(labels_map), 0);
   EXPECT_EQ(cv::countNonZero(labels_map != labels_slice), 0);
 }
 
 TEST(OctomapIo, RoomsYamlBecomesLabels) {
-  OccupancyGrid map;
+  common::OccupancyGrid map;
   map.resolution = 0.1;
-  map.cells = cv::Mat_<int8_t>(50, 50, OccupancyGrid::kUnknown);
+  map.cells = cv::Mat_<int8_t>(50, 50, common::OccupancyGrid::kUnknown);
   const std::string dir = testing::makeTempDir("octomap_rooms_yaml");
   std::ofstream(dir + "/rooms.yaml") << "rooms:\n"
                                         "  - {door_id: 4, label: 2, placed: true, polygon: [[1, 1], [2, 1], [2, 2], [1, 2]]}\n"
@@ -136,9 +136,9 @@ TEST(OctomapIo, RoomsYamlBecomesLabels) {
   EXPECT_EQ(cv::countNonZero(labels == 2), 11 * 11);  // corners on cell centres: 1.05 .. 2.05 inclusive
   EXPECT_EQ(cv::countNonZero(labels == 1), 0);
   std::ofstream(dir + "/bad.yaml") << "rooms:\n  - {label: 1, polygon: [[1, 1], [2, x]]}\n";
-  EXPECT_THROW(roomLabelsFromYaml(dir + "/bad.yaml", map), InputError);
+  EXPECT_THROW(roomLabelsFromYaml(dir + "/bad.yaml", map), common::InputError);
   std::ofstream(dir + "/none.yaml") << "method: default\n";
-  EXPECT_THROW(roomLabelsFromYaml(dir + "/none.yaml", map), InputError);
+  EXPECT_THROW(roomLabelsFromYaml(dir + "/none.yaml", map), common::InputError);
 }
 
 TEST(OctomapIo, BadInputGivesClearErrors) {
@@ -161,23 +161,24 @@ TEST(OctomapIo, BadInputGivesClearErrors) {
   EXPECT_NE(inputErrorMessage([&] { sliceOctomap(dir + "/garbage.bt", inverted); }).find("z_min < z_max"),
             std::string::npos);
 
-  OccupancyGrid map;
-  map.cells = cv::Mat_<int8_t>(10, 10, OccupancyGrid::kFree);
-  EXPECT_THROW(exportOctomap(map, cv::Mat1w(), ExtrusionOptions(), dir + "/map.txt"), InputError);
-  EXPECT_THROW(exportOctomap(map, cv::Mat1w::zeros(3, 3), ExtrusionOptions(), dir + "/map.ot"), InputError);
+  common::OccupancyGrid map;
+  map.cells = cv::Mat_<int8_t>(10, 10, common::OccupancyGrid::kFree);
+  EXPECT_THROW(exportOctomap(map, cv::Mat1w(), ExtrusionOptions(), dir + "/map.txt"), common::InputError);
+  EXPECT_THROW(exportOctomap(map, cv::Mat1w::zeros(3, 3), ExtrusionOptions(), dir + "/map.ot"), common::InputError);
   ExtrusionOptions flat;
   flat.height = 0.0;
-  EXPECT_THROW(exportOctomap(map, cv::Mat1w(), flat, dir + "/map.bt"), InputError);
-  EXPECT_THROW(exportOctomap(OccupancyGrid(), cv::Mat1w(), ExtrusionOptions(), dir + "/map.bt"), InputError);
-  EXPECT_THROW(exportOctomap(map, cv::Mat1w(), ExtrusionOptions(), dir + "/no/such/folder/map.bt"), InputError);
+  EXPECT_THROW(exportOctomap(map, cv::Mat1w(), flat, dir + "/map.bt"), common::InputError);
+  EXPECT_THROW(exportOctomap(common::OccupancyGrid(), cv::Mat1w(), ExtrusionOptions(), dir + "/map.bt"),
+               common::InputError);
+  EXPECT_THROW(exportOctomap(map, cv::Mat1w(), ExtrusionOptions(), dir + "/no/such/folder/map.bt"), common::InputError);
 }
 
 // OctoMap's readers follow a file's child bits past its end and to any depth (the fuzzer's out-of-memory input
 // is kept in test/fuzz/regressions/octomap): such files are refused before OctoMap reads them.
 TEST(OctomapIo, DamagedTreesAreRefusedBeforeOctomapReadsThem) {
   const std::string dir = testing::makeTempDir("octomap_damaged");
-  OccupancyGrid map;
-  DoorsFile doors;
+  common::OccupancyGrid map;
+  common::DoorsFile doors;
   cv::Mat1w truth;
   testing::syntheticHiddenRoomA(&map, &doors, &truth);
   const auto error = [](const std::string& path) {
@@ -219,4 +220,4 @@ TEST(OctomapIo, DamagedTreesAreRefusedBeforeOctomapReadsThem) {
 }
 
 }  // namespace
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::map3d

@@ -16,15 +16,15 @@
 #include "hidden_rooms/world/render.h"
 #include "test_util.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::mapping {
 namespace {
 
 const std::string kConfig = std::string(HIDDEN_ROOMS_SOURCE_DIR) + "/config/rbpf.ini";
 
 struct MappingRun {
-  OccupancyGrid map;
-  MapQuality quality;
-  TrajectoryError trajectory;
+  common::OccupancyGrid map;
+  evaluation::MapQuality quality;
+  evaluation::TrajectoryError trajectory;
   int scans = 0;
   int inserted = 0;
   std::vector<RbpfParticle> particles;
@@ -32,25 +32,25 @@ struct MappingRun {
 
 // Drives the robot (wander) through a world for `seconds` and maps it with scans at 10 Hz.
 MappingRun mapWorld(const std::string& world_file, double seconds, uint32_t mapper_seed) {
-  const Environment environment = loadEnvironment(world_file);
-  const RenderedEnvironment truth = renderEnvironment(environment, {});
-  SimulationOptions options;
+  const world::Environment environment = world::loadEnvironment(world_file);
+  const world::RenderedEnvironment truth = world::renderEnvironment(environment, {});
+  simulation::SimulationOptions options;
   options.seed = 3;
-  Simulation simulation(worldFromEnvironment(environment, {}), options);
+  simulation::Simulation simulation(simulation::worldFromEnvironment(environment, {}), options);
   RbpfMapperOptions mapper_options;
   mapper_options.config_file = kConfig;
   mapper_options.seed = mapper_seed;
   RbpfMapper mapper(mapper_options);
-  WanderDriver driver;
+  simulation::WanderDriver driver;
 
-  RangeScan scan;
-  const LaserGeometry& laser = simulation.laserGeometry();
+  common::RangeScan scan;
+  const common::LaserGeometry& laser = simulation.laserGeometry();
   scan.angle_min = laser.angle_min;
   scan.angle_increment = laser.angle_increment;
   scan.range_min = options.laser.min_range;
   scan.range_max = laser.max_range;
   scan.sensor_pose = options.laser.mount;
-  std::vector<Pose2> estimate, true_poses;
+  std::vector<common::Pose2> estimate, true_poses;
   cv::Mat1b observed;
   MappingRun run;
   const int steps = static_cast<int>(std::lround(seconds / options.physics_step));
@@ -60,15 +60,15 @@ MappingRun mapWorld(const std::string& world_file, double seconds, uint32_t mapp
     simulation.scan(&scan.ranges);
     simulation.setCommand(driver.next(scan.ranges, laser));
     if (mapper.addScan(simulation.odometryPose(), scan))
-      markObservedCells(truth.map, simulation.laserPose(), scan, &observed);
+      evaluation::markObservedCells(truth.map, simulation.laserPose(), scan, &observed);
     estimate.push_back(mapper.pose());
     true_poses.push_back(simulation.truePose());
     ++run.scans;
   }
-  const Pose2 world_from_map = composePoses(simulation.truePose(), invertPose(mapper.pose()));
+  const common::Pose2 world_from_map = common::composePoses(simulation.truePose(), common::invertPose(mapper.pose()));
   run.map = mapper.map();
-  run.quality = evaluateMap(run.map, world_from_map, truth.map, observed);
-  run.trajectory = trajectoryError(estimate, true_poses, world_from_map);
+  run.quality = evaluation::evaluateMap(run.map, world_from_map, truth.map, observed);
+  run.trajectory = evaluation::trajectoryError(estimate, true_poses, world_from_map);
   run.inserted = mapper.scansInserted();
   run.particles = mapper.particles();
   return run;
@@ -105,44 +105,44 @@ TEST(RbpfMapper, StartsAtTheFirstOdometryPose) {
   options.config_file = kConfig;
   RbpfMapper mapper(options);
   EXPECT_TRUE(mapper.map().empty());
-  RangeScan scan;
+  common::RangeScan scan;
   scan.angle_min = -1.0;
   scan.angle_increment = 0.01;
   scan.range_min = 0.05;
   scan.range_max = 10.0;
   scan.ranges.assign(201, 2.0f);
   EXPECT_TRUE(mapper.addScan({1.0, 2.0, 0.5}, scan));
-  const Pose2 pose = mapper.pose(), map_to_odom = mapper.mapToOdom();
+  const common::Pose2 pose = mapper.pose(), map_to_odom = mapper.mapToOdom();
   // The filter's first step draws the particles around the start (the motion model's minimum noise).
   EXPECT_NEAR(pose.x, 1.0, 0.02);
   EXPECT_NEAR(pose.y, 2.0, 0.02);
   EXPECT_NEAR(pose.yaw, 0.5, 0.02);
   EXPECT_NEAR(map_to_odom.x, 0.0, 0.02);
   EXPECT_NEAR(map_to_odom.yaw, 0.0, 0.02);
-  const OccupancyGrid map = mapper.map();
+  const common::OccupancyGrid map = mapper.map();
   ASSERT_FALSE(map.empty());
   int col = 0, row = 0;
-  ASSERT_TRUE(map.cellOf(Point2(1.0 + 1.0 * std::cos(0.5), 2.0 + 1.0 * std::sin(0.5)), &col, &row));
+  ASSERT_TRUE(map.cellOf(common::Point2(1.0 + 1.0 * std::cos(0.5), 2.0 + 1.0 * std::sin(0.5)), &col, &row));
   EXPECT_GE(map.cells(row, col), 0);
   EXPECT_LT(map.cells(row, col), 50) << "free in front of the robot";
-  ASSERT_TRUE(map.cellOf(Point2(1.0 + 2.0 * std::cos(0.5), 2.0 + 2.0 * std::sin(0.5)), &col, &row));
+  ASSERT_TRUE(map.cellOf(common::Point2(1.0 + 2.0 * std::cos(0.5), 2.0 + 2.0 * std::sin(0.5)), &col, &row));
   EXPECT_GT(map.cells(row, col), 50) << "the hit";
-  ASSERT_TRUE(map.cellOf(Point2(1.0 - 1.0 * std::cos(0.5), 2.0 - 1.0 * std::sin(0.5)), &col, &row));
-  EXPECT_EQ(map.cells(row, col), OccupancyGrid::kUnknown) << "behind the robot, outside the scan";
-  EXPECT_THROW(mapper.addScan({0.0, 0.0, 0.0}, RangeScan()), InputError);
+  ASSERT_TRUE(map.cellOf(common::Point2(1.0 - 1.0 * std::cos(0.5), 2.0 - 1.0 * std::sin(0.5)), &col, &row));
+  EXPECT_EQ(map.cells(row, col), common::OccupancyGrid::kUnknown) << "behind the robot, outside the scan";
+  EXPECT_THROW(mapper.addScan({0.0, 0.0, 0.0}, common::RangeScan()), common::InputError);
 }
 
 TEST(RbpfMapper, RejectsBadIniFiles) {
   const std::string dir = testing::makeTempDir("rbpf_ini");
   RbpfMapperOptions options;
   options.config_file = dir + "/missing.ini";
-  EXPECT_THROW({ RbpfMapper mapper(options); }, InputError);
+  EXPECT_THROW({ RbpfMapper mapper(options); }, common::InputError);
   options.config_file = dir + "/garbage.ini";
   std::ofstream(options.config_file) << "this is not [an ini\n\x01\x02 = =\n";
   try {
     RbpfMapper mapper(options);
     ADD_FAILURE() << "garbage accepted";
-  } catch (const InputError& error) {
+  } catch (const common::InputError& error) {
     EXPECT_NE(std::string(error.what()).find("garbage.ini"), std::string::npos) << error.what();
   }
   // A valid ini without the grid.
@@ -153,7 +153,7 @@ TEST(RbpfMapper, RejectsBadIniFiles) {
   text.replace(at, 23, "occupancyGrid_count = 0");
   options.config_file = dir + "/nogrid.ini";
   std::ofstream(options.config_file) << text;
-  EXPECT_THROW({ RbpfMapper mapper(options); }, InputError);
+  EXPECT_THROW({ RbpfMapper mapper(options); }, common::InputError);
 
   // A published map's certainty outside (0.5, 1).
   text.replace(at, 23, "occupancyGrid_count = 1");
@@ -166,10 +166,10 @@ TEST(RbpfMapper, RejectsBadIniFiles) {
   try {
     RbpfMapper mapper(options);
     ADD_FAILURE() << "certainty 1.5 accepted";
-  } catch (const InputError& error) {
+  } catch (const common::InputError& error) {
     EXPECT_NE(std::string(error.what()).find("PublishedMap"), std::string::npos) << error.what();
   }
 }
 
 }  // namespace
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::mapping

@@ -15,7 +15,7 @@
 #include "hidden_rooms/prediction/room_predictor.h"
 #include "test_util.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::prediction {
 namespace {
 
 // A synthetic floor: a corridor with three adjacent hidden rooms above it (their shared walls unseen; a known
@@ -60,38 +60,38 @@ Synthetic syntheticFloor(double degrees) {
       p = cv::Point2d(a(0, 0) * p.x + a(0, 1) * p.y + a(0, 2), a(1, 0) * p.x + a(1, 1) * p.y + a(1, 2));
   }
   Synthetic result;
-  OccupancyGrid& map = result.request.map;
+  common::OccupancyGrid& map = result.request.map;
   map.resolution = 0.05;
-  map.cells = cv::Mat_<int8_t>(size, OccupancyGrid::kUnknown);
+  map.cells = cv::Mat_<int8_t>(size, common::OccupancyGrid::kUnknown);
   for (int r = 0; r < size.height; ++r)
     for (int c = 0; c < size.width; ++c) {
-      if (rotated_states(r, c) == 1) map.cells(r, c) = OccupancyGrid::kFree;
-      if (rotated_states(r, c) == 2) map.cells(r, c) = OccupancyGrid::kOccupied;
+      if (rotated_states(r, c) == 1) map.cells(r, c) = common::OccupancyGrid::kFree;
+      if (rotated_states(r, c) == 2) map.cells(r, c) = common::OccupancyGrid::kOccupied;
     }
-  rotated_labels.setTo(0, map.cells != OccupancyGrid::kUnknown);
+  rotated_labels.setTo(0, map.cells != common::OccupancyGrid::kUnknown);
   result.truth = rotated_labels;
   for (size_t k = 0; k < doors.size(); ++k) {
-    MapDoor door;
+    common::MapDoor door;
     door.id = static_cast<int>(k + 1);
     door.width = 1.0;
-    door.orientation = DoorOrientation::kAlongX;
+    door.orientation = common::DoorOrientation::kAlongX;
     // Image point (column, row) -> map frame (y up, origin at the lower-left corner).
-    door.position = Point2(doors[k].x * map.resolution, (size.height - doors[k].y) * map.resolution);
+    door.position = common::Point2(doors[k].x * map.resolution, (size.height - doors[k].y) * map.resolution);
     result.request.doors.doors.push_back(door);
   }
   return result;
 }
 
-RoomScores scoreOf(const Synthetic& s, const PredictionResult& result) {
-  return scoreRooms(roomLabels(s.request.map, s.request.doors, result.rooms), s.truth,
-                    static_cast<int>(s.request.doors.doors.size()));
+evaluation::RoomScores scoreOf(const Synthetic& s, const PredictionResult& result) {
+  return evaluation::scoreRooms(roomLabels(s.request.map, s.request.doors, result.rooms), s.truth,
+                                static_cast<int>(s.request.doors.doors.size()));
 }
 
 TEST(DefaultPredictor, RecoversAdjacentRoomsBehindClosedDoors) {
   const Synthetic s = syntheticFloor(0.0);
   const PredictionResult result = makeRoomPredictor("default")->predict(s.request);
   ASSERT_EQ(result.rooms.size(), 4u);
-  const RoomScores scores = scoreOf(s, result);
+  const evaluation::RoomScores scores = scoreOf(s, result);
   for (size_t k = 0; k < scores.iou.size(); ++k) EXPECT_GT(scores.iou[k], 0.9) << "door " << k + 1;
 }
 
@@ -99,7 +99,7 @@ TEST(DefaultPredictor, RecoversRoomsOfARotatedMap) {
   const Synthetic s = syntheticFloor(20.0);
   EXPECT_NEAR(std::abs(dominantWallAngle(s.request.map)) * 180.0 / CV_PI, 20.0, 1.5);
   const PredictionResult result = makeRoomPredictor("default")->predict(s.request);
-  const RoomScores scores = scoreOf(s, result);
+  const evaluation::RoomScores scores = scoreOf(s, result);
   EXPECT_GT(scores.mean_iou, 0.8);
   for (size_t k = 0; k < scores.iou.size(); ++k) EXPECT_GT(scores.iou[k], 0.7) << "door " << k + 1;
 }
@@ -110,8 +110,8 @@ TEST(DefaultPredictor, MeasuresDepthBehindARaggedWall) {
   // behind them, not stopped on them.
   Synthetic s = syntheticFloor(0.0);
   for (int col = 40; col < 140; ++col)
-    if ((col < 78 || col > 102) && col % 4 != 0) s.request.map.cells(96, col) = OccupancyGrid::kOccupied;
-  s.truth.setTo(0, s.request.map.cells != OccupancyGrid::kUnknown);
+    if ((col < 78 || col > 102) && col % 4 != 0) s.request.map.cells(96, col) = common::OccupancyGrid::kOccupied;
+  s.truth.setTo(0, s.request.map.cells != common::OccupancyGrid::kUnknown);
   s.request.parameters = {{"default_grown_area_ratio", 1e9}};  // the rectangles only
   const PredictionResult result = makeRoomPredictor("default")->predict(s.request);
   EXPECT_NEAR(result.rooms[0].terms.at("depth"), 76 * 0.05, 0.1);
@@ -128,9 +128,9 @@ TEST(DefaultPredictor, IsDeterministic) {
 
 TEST(DefaultPredictor, ReportsADoorOutsideTheMapAndPredictsTheOthers) {
   Synthetic s = syntheticFloor(0.0);
-  MapDoor outside;
+  common::MapDoor outside;
   outside.id = 9;
-  outside.position = Point2(-20.0, -20.0);
+  outside.position = common::Point2(-20.0, -20.0);
   s.request.doors.doors.push_back(outside);
   const PredictionResult result = makeRoomPredictor("default")->predict(s.request);
   ASSERT_EQ(result.rooms.size(), 5u);
@@ -145,7 +145,7 @@ TEST(DefaultPredictor, NeverPredictsKnownCells) {
     const Synthetic s = syntheticFloor(degrees);
     const PredictionResult result = makeRoomPredictor("default")->predict(s.request);
     for (const RoomPrediction& room : result.rooms) {
-      EXPECT_EQ(cv::countNonZero(room.mask & (s.request.map.cells != OccupancyGrid::kUnknown)), 0);
+      EXPECT_EQ(cv::countNonZero(room.mask & (s.request.map.cells != common::OccupancyGrid::kUnknown)), 0);
       EXPECT_NEAR(room.area, cv::countNonZero(room.mask) * 0.0025, 1e-9);
     }
   }
@@ -155,7 +155,7 @@ TEST(DefaultPredictor, RejectsBadParameters) {
   const Synthetic s = syntheticFloor(0.0);
   PredictionRequest request = s.request;
   request.parameters["default_bounded_fraction"] = 2.0;
-  EXPECT_THROW(makeRoomPredictor("default")->predict(request), InputError);
+  EXPECT_THROW(makeRoomPredictor("default")->predict(request), common::InputError);
 }
 
 // Two hidden rooms above a corridor, their shared wall unseen; a pillar in the corridor marks where that wall
@@ -172,17 +172,17 @@ Synthetic corridorWithPillar() {
   result.truth = cv::Mat1w::zeros(size);
   result.truth(cv::Rect(20, 20, 130, 77)).setTo(1);
   result.truth(cv::Rect(153, 20, 127, 77)).setTo(2);
-  OccupancyGrid& map = result.request.map;
+  common::OccupancyGrid& map = result.request.map;
   map.resolution = 0.05;
-  map.cells = cv::Mat_<int8_t>(size, OccupancyGrid::kUnknown);
-  map.cells.setTo(OccupancyGrid::kFree, states == 1);
-  map.cells.setTo(OccupancyGrid::kOccupied, states == 2);
+  map.cells = cv::Mat_<int8_t>(size, common::OccupancyGrid::kUnknown);
+  map.cells.setTo(common::OccupancyGrid::kFree, states == 1);
+  map.cells.setTo(common::OccupancyGrid::kOccupied, states == 2);
   for (const auto& [id, column] : {std::pair<int, double>{1, 40.0}, {2, 175.0}}) {
-    MapDoor door;
+    common::MapDoor door;
     door.id = id;
     door.width = 1.0;
-    door.orientation = DoorOrientation::kAlongX;
-    door.position = Point2(column * map.resolution, (size.height - 98.5) * map.resolution);
+    door.orientation = common::DoorOrientation::kAlongX;
+    door.position = common::Point2(column * map.resolution, (size.height - 98.5) * map.resolution);
     result.request.doors.doors.push_back(door);
   }
   return result;
@@ -191,7 +191,7 @@ Synthetic corridorWithPillar() {
 TEST(DefaultPredictor, WallStubsEndTheRoomsAlongTheirWall) {
   Synthetic s = corridorWithPillar();
   s.request.parameters["default_grown_area_ratio"] = 1000.0;  // the wall-fitted rectangles only
-  const RoomScores with_stubs = scoreOf(s, makeRoomPredictor("default")->predict(s.request));
+  const evaluation::RoomScores with_stubs = scoreOf(s, makeRoomPredictor("default")->predict(s.request));
   for (size_t k = 0; k < with_stubs.iou.size(); ++k) EXPECT_GT(with_stubs.iou[k], 0.9) << "door " << k + 1;
   s.request.parameters["default_stub_length"] = 0.0;  // stubs ignored: cut halfway between the doors
   EXPECT_LT(scoreOf(s, makeRoomPredictor("default")->predict(s.request)).iou[0], 0.8);
@@ -202,17 +202,17 @@ Synthetic syntheticFromStates(const cv::Mat1b& states, const cv::Mat1w& truth,
                               const std::vector<cv::Point2d>& doors) {
   Synthetic result;
   result.truth = truth;
-  OccupancyGrid& map = result.request.map;
+  common::OccupancyGrid& map = result.request.map;
   map.resolution = 0.05;
-  map.cells = cv::Mat_<int8_t>(states.size(), OccupancyGrid::kUnknown);
-  map.cells.setTo(OccupancyGrid::kFree, states == 1);
-  map.cells.setTo(OccupancyGrid::kOccupied, states == 2);
+  map.cells = cv::Mat_<int8_t>(states.size(), common::OccupancyGrid::kUnknown);
+  map.cells.setTo(common::OccupancyGrid::kFree, states == 1);
+  map.cells.setTo(common::OccupancyGrid::kOccupied, states == 2);
   for (size_t k = 0; k < doors.size(); ++k) {
-    MapDoor door;
+    common::MapDoor door;
     door.id = static_cast<int>(k + 1);
     door.width = 1.0;
-    door.orientation = DoorOrientation::kAlongX;
-    door.position = Point2(doors[k].x * map.resolution, (states.rows - doors[k].y) * map.resolution);
+    door.orientation = common::DoorOrientation::kAlongX;
+    door.position = common::Point2(doors[k].x * map.resolution, (states.rows - doors[k].y) * map.resolution);
     result.request.doors.doors.push_back(door);
   }
   return result;
@@ -255,9 +255,9 @@ TEST(DefaultPredictor, OverlapOfPerpendicularDoorsGoesToTheNearerDoor) {
   truth(cv::Rect(113, 48, 107, 85)).setTo(1);   // behind the north door: rows 48..132
   truth(cv::Rect(48, 133, 172, 87)).setTo(2);   // behind the west door: rows 133..219, the block's width
   Synthetic s = syntheticFromStates(states, truth, {{165, 46}, {46, 190}});
-  s.request.doors.doors[1].orientation = DoorOrientation::kAlongY;
+  s.request.doors.doors[1].orientation = common::DoorOrientation::kAlongY;
   s.request.parameters["default_grown_area_ratio"] = 1000.0;  // the wall-fitted rectangles only
-  const RoomScores scores = scoreOf(s, makeRoomPredictor("default")->predict(s.request));
+  const evaluation::RoomScores scores = scoreOf(s, makeRoomPredictor("default")->predict(s.request));
   for (size_t k = 0; k < scores.iou.size(); ++k) EXPECT_GT(scores.iou[k], 0.9) << "door " << k + 1;
 }
 
@@ -325,4 +325,4 @@ TEST(DefaultPredictor, KeepsItsAccuracyOnTheBenchmark) {
 }
 
 }  // namespace
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::prediction

@@ -17,7 +17,7 @@
 #include "hidden_rooms/prediction/structured_predictor.h"
 #include "test_util.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::prediction {
 namespace {
 
 // ---------------------------------------------------------------------------------------------------------
@@ -28,12 +28,12 @@ namespace {
 //           its closed door is part of the corridor's top wall, centred at (212, 118)
 //   corridor: interior x [20, 280), y [120, 160)
 struct SyntheticFloor {
-  OccupancyGrid map;
-  DoorsFile doors;
+  common::OccupancyGrid map;
+  common::DoorsFile doors;
   cv::Mat1b hidden_room;  // true interior of room B
   int scale = 1;
   // Centre of a base-pixel position in image coordinates.
-  Point2 image(double x, double y) const { return Point2(x * scale, y * scale); }
+  common::Point2 image(double x, double y) const { return common::Point2(x * scale, y * scale); }
 };
 
 SyntheticFloor makeFloor(int scale) {
@@ -56,19 +56,19 @@ SyntheticFloor makeFloor(int scale) {
   floor.hidden_room(rect(144, 20, 280, 116)).setTo(255);
 
   floor.map.resolution = 0.05 / scale;
-  floor.map.origin = Point2(-2.0, 1.0);
+  floor.map.origin = common::Point2(-2.0, 1.0);
   floor.map.cells.create(grey.size());
   for (int r = 0; r < grey.rows; ++r)
     for (int c = 0; c < grey.cols; ++c)
-      floor.map.cells(r, c) = grey(r, c) == 0     ? OccupancyGrid::kOccupied
-                              : grey(r, c) == 254 ? OccupancyGrid::kFree
-                                                  : OccupancyGrid::kUnknown;
-  MapDoor door;
+      floor.map.cells(r, c) = grey(r, c) == 0     ? common::OccupancyGrid::kOccupied
+                              : grey(r, c) == 254 ? common::OccupancyGrid::kFree
+                                                  : common::OccupancyGrid::kUnknown;
+  common::MapDoor door;
   door.id = 7;
   door.width = 0.9;
-  door.orientation = DoorOrientation::kAlongX;
-  const Point2 door_image = floor.image(212, 118);
-  door.position = floor.map.origin + floor.map.resolution * Point2(door_image.x(), grey.rows - door_image.y());
+  door.orientation = common::DoorOrientation::kAlongX;
+  const common::Point2 door_image = floor.image(212, 118);
+  door.position = floor.map.origin + floor.map.resolution * common::Point2(door_image.x(), grey.rows - door_image.y());
   floor.doors.doors.push_back(door);
   return floor;
 }
@@ -158,24 +158,24 @@ TEST(Structured, RecoversTheErasedRectangularRoom) {
     EXPECT_EQ(room.door_id, 7);
     ASSERT_TRUE(room.placed) << room.problem;
     EXPECT_GT(iou(room.mask, floor.hidden_room), 0.9);
-    EXPECT_EQ(cv::countNonZero(room.mask & (floor.map.cells != OccupancyGrid::kUnknown)), 0);
+    EXPECT_EQ(cv::countNonZero(room.mask & (floor.map.cells != common::OccupancyGrid::kUnknown)), 0);
     EXPECT_NEAR(room.area, cv::countNonZero(room.mask) * floor.map.resolution * floor.map.resolution, 1e-9);
     // Room B's interior is 6.8 m x 4.8 m; the prediction adds the erased walls' cells on the cell's edges.
     EXPECT_GT(room.area, 6.8 * 4.8);
     EXPECT_LT(room.area, 1.1 * 6.8 * 4.8);
-    EXPECT_NEAR(area(room.polygon), room.area, 0.05 * room.area);
+    EXPECT_NEAR(common::area(room.polygon), room.area, 0.05 * room.area);
     EXPECT_EQ(room.terms.at("cells"), 1.0);
   }
 }
 
 TEST(Structured, DoorOutsideTheMapOrFarFromUnknownIsNotPlacedOthersAre) {
   SyntheticFloor floor = makeFloor(1);
-  MapDoor outside;
+  common::MapDoor outside;
   outside.id = 8;
-  outside.position = floor.map.origin + Point2(-5.0, -5.0);
-  MapDoor in_room_a;  // the middle of room A: no unknown cell edge within 2 m
+  outside.position = floor.map.origin + common::Point2(-5.0, -5.0);
+  common::MapDoor in_room_a;  // the middle of room A: no unknown cell edge within 2 m
   in_room_a.id = 9;
-  in_room_a.position = floor.map.origin + 0.05 * Point2(80, 200 - 68);
+  in_room_a.position = floor.map.origin + 0.05 * common::Point2(80, 200 - 68);
   floor.doors.doors.insert(floor.doors.doors.begin(), outside);
   floor.doors.doors.push_back(in_room_a);
 
@@ -208,12 +208,12 @@ TEST(Structured, RejectsUnknownParametersAndEmptyMapsAndAppliesLayoutParameters)
   try {
     predictor.predict(request);
     FAIL() << "unknown parameter accepted";
-  } catch (const InputError& error) {
+  } catch (const common::InputError& error) {
     EXPECT_EQ(error.source(), "parameters");
     EXPECT_NE(error.problem().find("no_such_parameter"), std::string::npos) << error.what();
   }
   request.parameters = {{"canny_aperture", 4.0}};
-  EXPECT_THROW(predictor.predict(request), InputError);
+  EXPECT_THROW(predictor.predict(request), common::InputError);
 
   // A layout parameter takes effect: with every cell counted IN, no door finds unknown space.
   request.parameters = {{"out_unknown_fraction", 1.0}};
@@ -223,8 +223,8 @@ TEST(Structured, RejectsUnknownParametersAndEmptyMapsAndAppliesLayoutParameters)
 
   PredictionRequest empty;
   empty.doors = floor.doors;
-  EXPECT_THROW(predictor.predict(empty), InputError);
-  EXPECT_THROW(analyzeLayout(OccupancyGrid(), {}), InputError);
+  EXPECT_THROW(predictor.predict(empty), common::InputError);
+  EXPECT_THROW(analyzeLayout(common::OccupancyGrid(), {}), common::InputError);
 
   // The predictor reads exactly the layout parameters.
   std::map<std::string, double> defaults = predictor.defaultParameters();
@@ -234,18 +234,18 @@ TEST(Structured, RejectsUnknownParametersAndEmptyMapsAndAppliesLayoutParameters)
 // No segments: the boundary lines surround the image, one border cell (pixels past the image count as unknown).
 TEST(Layout, MapsWithoutWallsGiveOneBorderCellAndNoStart) {
   for (const cv::Size size : {cv::Size(1, 1), cv::Size(7, 5), cv::Size(40, 30)})
-    for (const int8_t value : {OccupancyGrid::kUnknown, OccupancyGrid::kFree}) {
+    for (const int8_t value : {common::OccupancyGrid::kUnknown, common::OccupancyGrid::kFree}) {
       SCOPED_TRACE(std::to_string(size.width) + "x" + std::to_string(size.height) + " of " + std::to_string(value));
-      OccupancyGrid map;
+      common::OccupancyGrid map;
       map.cells = cv::Mat_<int8_t>(size, value);
-      MapDoor door;
+      common::MapDoor door;
       door.id = 1;
       door.position = map.cellCentre(0, 0);
       const Layout layout = analyzeLayout(map, {door});
       EXPECT_TRUE(layout.segments.empty());
       ASSERT_EQ(layout.grid.size(), 1);
       EXPECT_TRUE(layout.grid.cells[0].border);
-      EXPECT_TRUE(value != OccupancyGrid::kUnknown || layout.grid.cells[0].out);
+      EXPECT_TRUE(value != common::OccupancyGrid::kUnknown || layout.grid.cells[0].out);
       ASSERT_EQ(layout.doors.size(), 1u);
       EXPECT_FALSE(layout.doors[0].found);
       EXPECT_FALSE(layout.doors[0].problem.empty());
@@ -264,7 +264,7 @@ TEST(Layout, ParametersByNameValidateAndRejectUnknownNames) {
   try {
     layoutOptionsFromParameters({{"x", 1.0}});
     FAIL() << "unknown parameter accepted";
-  } catch (const InputError& error) {
+  } catch (const common::InputError& error) {
     EXPECT_EQ(error.source(), "parameters");
     EXPECT_EQ(error.problem(), "unknown parameter 'x'");
   }
@@ -272,10 +272,10 @@ TEST(Layout, ParametersByNameValidateAndRejectUnknownNames) {
   LayoutOptions applied;
   applyLayoutParameters({{"skewnormal_sigma", 3.0}, {"boundary_offset", 2.0}}, &applied);
   EXPECT_DOUBLE_EQ(applied.boundary_offset, 2.0);
-  EXPECT_THROW(applyLayoutParameters({{"dbscan_eps", 1.5}}, &applied), InputError);
-  EXPECT_THROW(layoutOptionsFromParameters({{"dbscan_min_points", 0.5}}), InputError);
-  EXPECT_THROW(layoutOptionsFromParameters({{"door_pair_lines", 2}}), InputError);
-  EXPECT_THROW(layoutOptionsFromParameters({{"hough_threshold", -1}}), InputError);
+  EXPECT_THROW(applyLayoutParameters({{"dbscan_eps", 1.5}}, &applied), common::InputError);
+  EXPECT_THROW(layoutOptionsFromParameters({{"dbscan_min_points", 0.5}}), common::InputError);
+  EXPECT_THROW(layoutOptionsFromParameters({{"door_pair_lines", 2}}), common::InputError);
+  EXPECT_THROW(layoutOptionsFromParameters({{"hough_threshold", -1}}), common::InputError);
 }
 
 TEST(Layout, ConfigFileEqualsCodeDefaults) {
@@ -309,7 +309,7 @@ TEST(Layout, WritesEveryDebugImageAndFailsOnAnUnwritableFolder) {
   }
   const std::string file = testing::makeTempDir("layout_debug_blocked") + "/a_file";
   std::ofstream(file) << "not a folder";
-  EXPECT_THROW(analyzeLayout(floor.map, floor.doors.doors, LayoutOptions(), file + "/stages"), InputError);
+  EXPECT_THROW(analyzeLayout(floor.map, floor.doors.doors, LayoutOptions(), file + "/stages"), common::InputError);
 }
 
 // ---------------------------------------------------------------------------------------------------------
@@ -352,16 +352,16 @@ TEST(LayoutBenchmark, HoughSegmentsLieOnOccupiedPixels) {
   ASSERT_FALSE(maps.empty());
   for (const std::string& path : maps) {
     SCOPED_TRACE(path);
-    const OccupancyGrid map = loadMap(path);
+    const common::OccupancyGrid map = common::loadMap(path);
     const Layout layout = analyzeLayout(map, {});
     ASSERT_GT(layout.segments.size(), 50u);
     cv::Mat1f distance;  // pixels to the nearest occupied pixel
-    cv::distanceTransform(cv::Mat1b(map.cells != OccupancyGrid::kOccupied), distance, cv::DIST_L2, 3);
+    cv::distanceTransform(cv::Mat1b(map.cells != common::OccupancyGrid::kOccupied), distance, cv::DIST_L2, 3);
     int samples = 0, near_wall = 0;
     for (const ImageSegment& segment : layout.segments) {
       const int steps = std::max(1, static_cast<int>(std::ceil(segment.length())));
       for (int k = 0; k <= steps; ++k) {
-        const Point2 p = segment.a + (segment.b - segment.a) * (static_cast<double>(k) / steps);
+        const common::Point2 p = segment.a + (segment.b - segment.a) * (static_cast<double>(k) / steps);
         const int c = std::clamp(static_cast<int>(std::floor(p.x())), 0, map.width() - 1);
         const int r = std::clamp(static_cast<int>(std::floor(p.y())), 0, map.height() - 1);
         ++samples;
@@ -382,8 +382,8 @@ TEST(LayoutBenchmark, EveryClosedDoorOfValidCasesGetsAStartCell) {
   ASSERT_GE(cases.size(), 40u);
   for (const BenchmarkCase& benchmark : cases) {
     SCOPED_TRACE(benchmark.name);
-    const OccupancyGrid map = loadMap(benchmark.dir + "/map.yaml");
-    const DoorsFile doors = loadDoors(benchmark.dir + "/doors.yaml");
+    const common::OccupancyGrid map = common::loadMap(benchmark.dir + "/map.yaml");
+    const common::DoorsFile doors = common::loadDoors(benchmark.dir + "/doors.yaml");
     const Layout layout = analyzeLayout(map, doors.doors);
     ASSERT_EQ(layout.doors.size(), doors.doors.size());
     for (const DoorStart& start : layout.doors) {
@@ -405,15 +405,15 @@ TEST(StructuredBenchmark, NeverPredictsKnownCellsAndReportsIoU) {
   for (const BenchmarkCase& benchmark : cases) {
     SCOPED_TRACE(benchmark.name);
     PredictionRequest request;
-    request.map = loadMap(benchmark.dir + "/map.yaml");
-    request.doors = loadDoors(benchmark.dir + "/doors.yaml");
+    request.map = common::loadMap(benchmark.dir + "/map.yaml");
+    request.doors = common::loadDoors(benchmark.dir + "/doors.yaml");
     const auto start = std::chrono::steady_clock::now();
     const PredictionResult result = predictor.predict(request);
     seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
     const cv::Mat truth = cv::imread(benchmark.dir + "/gt_rooms.png", cv::IMREAD_UNCHANGED);
     ASSERT_EQ(truth.size(), request.map.cells.size());
     ASSERT_EQ(result.rooms.size(), request.doors.doors.size());
-    const cv::Mat1b known = request.map.cells != OccupancyGrid::kUnknown;
+    const cv::Mat1b known = request.map.cells != common::OccupancyGrid::kUnknown;
     double total = 0;
     for (size_t k = 0; k < result.rooms.size(); ++k) {
       const RoomPrediction& room = result.rooms[k];
@@ -438,4 +438,4 @@ TEST(StructuredBenchmark, NeverPredictsKnownCellsAndReportsIoU) {
 }
 
 }  // namespace
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::prediction

@@ -17,7 +17,7 @@
 #include "hidden_rooms/world/render.h"
 #include "test_util.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::prediction {
 namespace {
 
 std::pair<PredictionRequest, cv::Mat1w> hiddenRoomA() {
@@ -33,7 +33,7 @@ TEST(Evaluation, ScoresHandMadeLabelImages) {
   truth(cv::Rect(0, 0, 1, 2)).setTo(1);
   truth(cv::Rect(4, 0, 2, 2)).setTo(2);      // door 2: nothing predicted
   predicted(cv::Rect(4, 2, 1, 1)).setTo(3);  // door 3: predicted, no truth
-  const RoomScores scores = scoreRooms(predicted, truth, 3);
+  const evaluation::RoomScores scores = evaluation::scoreRooms(predicted, truth, 3);
   ASSERT_EQ(scores.iou.size(), 3u);
   EXPECT_DOUBLE_EQ(scores.iou[0], 2.0 / 4.0);
   EXPECT_DOUBLE_EQ(scores.iou[1], 0.0);
@@ -41,12 +41,12 @@ TEST(Evaluation, ScoresHandMadeLabelImages) {
   EXPECT_DOUBLE_EQ(scores.mean_iou, 0.5 / 3.0);
   // Union of all predictions: 5 cells; of all truths: 6; together 2 common of 9.
   EXPECT_DOUBLE_EQ(scores.iou_total, 2.0 / 9.0);
-  EXPECT_DOUBLE_EQ(scoreRooms(truth, truth, 2).mean_iou, 1.0);
+  EXPECT_DOUBLE_EQ(evaluation::scoreRooms(truth, truth, 2).mean_iou, 1.0);
   cv::Mat1w wide = cv::Mat1w::zeros(4, 6);
   wide(0, 0) = 300;
-  EXPECT_DOUBLE_EQ(scoreRooms(wide, wide, 300).iou[299], 1.0);
-  EXPECT_THROW(scoreRooms(predicted, cv::Mat1b::zeros(5, 6), 3), InputError);
-  EXPECT_THROW(scoreRooms(cv::Mat3b::zeros(4, 6), truth, 3), InputError);
+  EXPECT_DOUBLE_EQ(evaluation::scoreRooms(wide, wide, 300).iou[299], 1.0);
+  EXPECT_THROW(evaluation::scoreRooms(predicted, cv::Mat1b::zeros(5, 6), 3), common::InputError);
+  EXPECT_THROW(evaluation::scoreRooms(cv::Mat3b::zeros(4, 6), truth, 3), common::InputError);
 }
 
 TEST(Prediction, MethodsAreChosenByName) {
@@ -61,8 +61,8 @@ TEST(Prediction, ParametersAreResolvedPerMethod) {
   const auto resolved = resolveParameters(*unstructured, {{"start_search_radius", 2.0}, {"skewnormal_sigma", 1.0}});
   EXPECT_DOUBLE_EQ(resolved.at("start_search_radius"), 2.0);
   EXPECT_EQ(resolved.count("skewnormal_sigma"), 0u);  // another method's parameter: ignored
-  EXPECT_THROW(resolveParameters(*unstructured, {{"start_serach_radius", 2.0}}), InputError);
-  EXPECT_THROW(resolveParameters(*unstructured, {{"start_search_radius", std::nan("")}}), InputError);
+  EXPECT_THROW(resolveParameters(*unstructured, {{"start_serach_radius", 2.0}}), common::InputError);
+  EXPECT_THROW(resolveParameters(*unstructured, {{"start_search_radius", std::nan("")}}), common::InputError);
 }
 
 TEST(Prediction, ShippedParameterFileEqualsTheDefaults) {
@@ -86,7 +86,7 @@ TEST(Prediction, BaselinesNeverPredictKnownCells) {
     const RoomPrediction& room = result.rooms[0];
     EXPECT_TRUE(room.placed) << room.problem;
     EXPECT_EQ(room.door_id, 1);
-    EXPECT_EQ(cv::countNonZero(room.mask & (request.map.cells != OccupancyGrid::kUnknown)), 0);
+    EXPECT_EQ(cv::countNonZero(room.mask & (request.map.cells != common::OccupancyGrid::kUnknown)), 0);
     EXPECT_NEAR(room.area, cv::countNonZero(room.mask) * 0.0025, 1e-9);
     EXPECT_GE(room.polygon.size(), 3u);
   }
@@ -95,7 +95,8 @@ TEST(Prediction, BaselinesNeverPredictKnownCells) {
 TEST(Prediction, UnstructuredRecoversAWalledHiddenRoom) {
   const auto [request, truth] = hiddenRoomA();
   const PredictionResult result = makeRoomPredictor("unstructured")->predict(request);
-  const RoomScores scores = scoreRooms(roomLabels(request.map, request.doors, result.rooms), truth, 1);
+  const evaluation::RoomScores scores =
+      evaluation::scoreRooms(roomLabels(request.map, request.doors, result.rooms), truth, 1);
   EXPECT_GT(scores.mean_iou, 0.9);
 }
 
@@ -108,17 +109,17 @@ TEST(Prediction, SkewNormalExtrapolatesIntoTheUnknownSide) {
   request.parameters["skewnormal_p_th"] = 0.8;
   EXPECT_LT(cv::countNonZero(makeRoomPredictor("skewnormal")->predict(request).rooms[0].mask), cv::countNonZero(mask));
   request.parameters["skewnormal_p_th"] = 1.5;
-  EXPECT_THROW(makeRoomPredictor("skewnormal")->predict(request), InputError);
+  EXPECT_THROW(makeRoomPredictor("skewnormal")->predict(request), common::InputError);
 }
 
 TEST(Prediction, DoorsThatCannotBePlacedAreReportedAndTheOthersStillPredicted) {
   auto [request, truth] = hiddenRoomA();
-  MapDoor outside = request.doors.doors[0];
+  common::MapDoor outside = request.doors.doors[0];
   outside.id = 9;
-  outside.position = Point2(100.0, 100.0);
-  MapDoor in_the_open = request.doors.doors[0];
+  outside.position = common::Point2(100.0, 100.0);
+  common::MapDoor in_the_open = request.doors.doors[0];
   in_the_open.id = 10;
-  in_the_open.position = Point2(7.0, 2.3);  // inside room B: no unknown cell within 2 m
+  in_the_open.position = common::Point2(7.0, 2.3);  // inside room B: no unknown cell within 2 m
   request.doors.doors = {outside, request.doors.doors[0], in_the_open};
   for (const std::string& name : roomPredictorNames()) {
     SCOPED_TRACE(name);
@@ -134,41 +135,45 @@ TEST(Prediction, DoorsThatCannotBePlacedAreReportedAndTheOthersStillPredicted) {
 
 TEST(Prediction, EmptyOrUnknownMapsAreRejected) {
   PredictionRequest request;
-  for (const std::string& name : roomPredictorNames()) EXPECT_THROW(makeRoomPredictor(name)->predict(request), InputError);
-  request.map.cells = cv::Mat_<int8_t>(10, 10, OccupancyGrid::kUnknown);
-  for (const std::string& name : roomPredictorNames()) EXPECT_THROW(makeRoomPredictor(name)->predict(request), InputError);
+  for (const std::string& name : roomPredictorNames())
+    EXPECT_THROW(makeRoomPredictor(name)->predict(request), common::InputError);
+  request.map.cells = cv::Mat_<int8_t>(10, 10, common::OccupancyGrid::kUnknown);
+  for (const std::string& name : roomPredictorNames())
+    EXPECT_THROW(makeRoomPredictor(name)->predict(request), common::InputError);
 }
 
 TEST(Prediction, InsertionFillsTheRoomAndOpensItsDoor) {
   const auto [request, truth] = hiddenRoomA();
   const PredictionResult result = makeRoomPredictor("unstructured")->predict(request);
-  const OccupancyGrid completed = insertRooms(request.map, request.doors, result.rooms);
-  EXPECT_EQ(cv::countNonZero((completed.cells == OccupancyGrid::kFree) & result.rooms[0].mask),
+  const common::OccupancyGrid completed = insertRooms(request.map, request.doors, result.rooms);
+  EXPECT_EQ(cv::countNonZero((completed.cells == common::OccupancyGrid::kFree) & result.rooms[0].mask),
             cv::countNonZero(result.rooms[0].mask));
   // The door is open: from the corridor the flood reaches the inserted room.
   int col = 0, row = 0;
-  ASSERT_TRUE(completed.cellOf(Point2(5.0, 5.0), &col, &row));
-  const cv::Mat1b reached = reachableFreeCells(completed, col, row);
+  ASSERT_TRUE(completed.cellOf(common::Point2(5.0, 5.0), &col, &row));
+  const cv::Mat1b reached = common::reachableFreeCells(completed, col, row);
   EXPECT_GT(cv::countNonZero(reached & result.rooms[0].mask), 0.9 * cv::countNonZero(result.rooms[0].mask));
   // Nothing known in the input is lost except the door's own cells.
-  EXPECT_LT(cv::countNonZero((request.map.cells == OccupancyGrid::kOccupied) & (completed.cells == OccupancyGrid::kFree)),
+  EXPECT_LT(cv::countNonZero((request.map.cells == common::OccupancyGrid::kOccupied) &
+                             (completed.cells == common::OccupancyGrid::kFree)),
             30);
 }
 
 // Two overlapping square rooms on a 20 x 10 unknown map (0.1 m cells): room 1 covers columns 2..11, room 2
 // columns 8..17; the doors sit on the left and right edges.
 struct OverlappingRooms {
-  OccupancyGrid map;
-  DoorsFile doors;
+  common::OccupancyGrid map;
+  common::DoorsFile doors;
   std::vector<RoomPrediction> rooms;
 };
 
 OverlappingRooms overlappingRooms() {
   OverlappingRooms s;
-  s.map.cells = cv::Mat_<int8_t>(10, 20, OccupancyGrid::kUnknown);
-  s.map.cells(cv::Rect(0, 0, 20, 1)).setTo(OccupancyGrid::kFree);
+  s.map.cells = cv::Mat_<int8_t>(10, 20, common::OccupancyGrid::kUnknown);
+  s.map.cells(cv::Rect(0, 0, 20, 1)).setTo(common::OccupancyGrid::kFree);
   s.map.resolution = 0.1;
-  s.doors.doors = {{1, Point2(0.2, 0.5), 0.9, DoorOrientation::kAlongY}, {2, Point2(1.8, 0.5), 0.9, DoorOrientation::kAlongY}};
+  s.doors.doors = {{1, common::Point2(0.2, 0.5), 0.9, common::DoorOrientation::kAlongY},
+                   {2, common::Point2(1.8, 0.5), 0.9, common::DoorOrientation::kAlongY}};
   for (int k = 0; k < 2; ++k) {
     RoomPrediction room;
     room.door_id = k + 1;
@@ -214,7 +219,7 @@ TEST(Prediction, OverlayTintsPredictedRoomsAndOutlinesTheTrueOnes) {
   for (const cv::Point& cell : {cv::Point(0, 0), cv::Point(0, 9), cv::Point(19, 5)})  // no room there
     EXPECT_EQ(tinted(cell), cv::Vec3b(grey(cell), grey(cell), grey(cell)));
   for (const cv::Point& cell : {cv::Point(2, 2), cv::Point(9, 7), cv::Point(10, 2), cv::Point(17, 7)}) {
-    const cv::Vec3b colour = roomColour(labels(cell));
+    const cv::Vec3b colour = common::roomColour(labels(cell));
     for (int channel = 0; channel < 3; ++channel)
       EXPECT_NEAR(tinted(cell)[channel], 0.4 * grey(cell) + 0.6 * colour[channel], 1.0) << cell;
   }
@@ -244,4 +249,4 @@ TEST(Prediction, BaselinesKeepTheirAccuracyOnTheBenchmark) {
 }
 
 }  // namespace
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::prediction

@@ -15,7 +15,7 @@
 #include "hidden_rooms/prediction/thesis_predictor.h"
 #include "test_util.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::prediction {
 namespace {
 
 // A hand-made grid of `columns` x `rows` square cells of `side` pixels, all OUT and not border.
@@ -121,8 +121,8 @@ Layout walledBlockLayout() {
   door.found = true;
   door.start_cell = grid.index(2, 2);
   door.explored_cell = grid.index(2, 3);
-  door.edge.a = Point2(80, 120);
-  door.edge.b = Point2(120, 120);
+  door.edge.a = common::Point2(80, 120);
+  door.edge.b = common::Point2(120, 120);
   layout.doors = {door};
   return layout;
 }
@@ -159,8 +159,8 @@ TEST(ThesisExpansion, NeighbouringRoomsShareABlock) {
     door.found = true;
     door.start_cell = grid.index(1 + 3 * k, 2);
     door.explored_cell = grid.index(1 + 3 * k, 3);
-    door.edge.a = Point2(40 + 120 * k, 120);
-    door.edge.b = Point2(80 + 120 * k, 120);
+    door.edge.a = common::Point2(40 + 120 * k, 120);
+    door.edge.b = common::Point2(80 + 120 * k, 120);
     doors.push_back(door);
   }
   layout.doors = doors;
@@ -203,26 +203,26 @@ void drawnFloor(PredictionRequest* request, cv::Mat1w* truth) {
   *truth = cv::Mat1w::zeros(height, width);
   (*truth)(cv::Rect(20, 40, 100 - wall / 2, 120)).setTo(1);
   (*truth)(cv::Rect(120 + wall / 2, 40, 120 - wall / 2, 120)).setTo(2);
-  request->map.cells = cv::Mat_<int8_t>(height, width, OccupancyGrid::kUnknown);
-  request->map.cells.setTo(OccupancyGrid::kFree, grey == 254);
-  request->map.cells.setTo(OccupancyGrid::kOccupied, grey == 0);
+  request->map.cells = cv::Mat_<int8_t>(height, width, common::OccupancyGrid::kUnknown);
+  request->map.cells.setTo(common::OccupancyGrid::kFree, grey == 254);
+  request->map.cells.setTo(common::OccupancyGrid::kOccupied, grey == 0);
   request->map.resolution = 0.05;
-  request->map.origin = Point2::Zero();
+  request->map.origin = common::Point2::Zero();
   request->doors.doors.clear();
   for (int k = 0; k < 2; ++k) {
-    MapDoor door;
+    common::MapDoor door;
     door.id = k + 1;
     const double column = k == 0 ? 70.0 : 180.0;
-    door.position = Point2(column * 0.05, (height - 160 + wall / 2.0) * 0.05);
+    door.position = common::Point2(column * 0.05, (height - 160 + wall / 2.0) * 0.05);
     door.width = 0.9;
-    door.orientation = DoorOrientation::kAlongX;
+    door.orientation = common::DoorOrientation::kAlongX;
     request->doors.doors.push_back(door);
   }
 }
 
 double meanIou(const PredictionRequest& request, const PredictionResult& result, const cv::Mat1w& truth) {
-  return scoreRooms(roomLabels(request.map, request.doors, result.rooms), truth,
-                    static_cast<int>(request.doors.doors.size()))
+  return evaluation::scoreRooms(roomLabels(request.map, request.doors, result.rooms), truth,
+                                static_cast<int>(request.doors.doors.size()))
       .mean_iou;
 }
 
@@ -242,11 +242,12 @@ TEST(ThesisPredictor, RecoversTwoRoomsOnADrawnFloor) {
   drawnFloor(&request, &truth);
   const PredictionResult result = makeRoomPredictor("thesis")->predict(request);
   ASSERT_EQ(result.rooms.size(), 2u);
-  const RoomScores scores = scoreRooms(roomLabels(request.map, request.doors, result.rooms), truth, 2);
+  const evaluation::RoomScores scores =
+      evaluation::scoreRooms(roomLabels(request.map, request.doors, result.rooms), truth, 2);
   EXPECT_GT(scores.iou[0], 0.8);
   EXPECT_GT(scores.iou[1], 0.8);
   for (const RoomPrediction& room : result.rooms)
-    EXPECT_EQ(cv::countNonZero(room.mask & (request.map.cells != OccupancyGrid::kUnknown)), 0);
+    EXPECT_EQ(cv::countNonZero(room.mask & (request.map.cells != common::OccupancyGrid::kUnknown)), 0);
 }
 
 TEST(ThesisPredictor, IsDeterministic) {
@@ -266,9 +267,9 @@ TEST(ThesisPredictor, DoorOutsideTheMapIsReportedAndTheOthersPredicted) {
   PredictionRequest request;
   cv::Mat1w truth;
   drawnFloor(&request, &truth);
-  MapDoor outside = request.doors.doors[0];
+  common::MapDoor outside = request.doors.doors[0];
   outside.id = 7;
-  outside.position = Point2(100.0, 100.0);
+  outside.position = common::Point2(100.0, 100.0);
   request.doors.doors.insert(request.doors.doors.begin() + 1, outside);
   const PredictionResult result = makeRoomPredictor("thesis")->predict(request);
   ASSERT_EQ(result.rooms.size(), 3u);
@@ -301,7 +302,7 @@ TEST(ThesisPredictor, ParametersAreValidated) {
                                                                   {"thesis_fix_pairs", 0.5},
                                                                   {"thesis_proportion_threshold", 0.5}}) {
     request.parameters = {{name, value}};
-    EXPECT_THROW(method->predict(request), InputError) << name;
+    EXPECT_THROW(method->predict(request), common::InputError) << name;
   }
 }
 
@@ -315,4 +316,4 @@ TEST(ThesisPredictor, KeepsItsAccuracyOnTheBenchmark) {
 }
 
 }  // namespace
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::prediction

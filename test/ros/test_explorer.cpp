@@ -41,7 +41,7 @@ struct Figures {
   double path_length = 0.0;
   double min_clearance = 1e9;  // metres between the footprint and the nearest wall cell (less half a cell), fine grid
   double longest_stall = 0.0;  // simulated seconds without moving 0.05 m or turning 0.15 rad
-  Pose2 closest_pose;          // world frame pose where min_clearance was reached, and when
+  common::Pose2 closest_pose;  // world frame pose where min_clearance was reached, and when
   double closest_time = 0.0;
 };
 
@@ -63,13 +63,13 @@ class ExplorerTest : public ::testing::Test {
 
     private_nh.param("clearance_resolution", clearance_resolution_, clearance_resolution_);
 
-    const Environment environment = loadEnvironment(world_);
-    const std::set<int> closed = parseDoorSelection(environment, closed_doors_, "~closed_doors");
-    truth_ = renderEnvironment(environment, closed).map;
+    const world::Environment environment = world::loadEnvironment(world_);
+    const std::set<int> closed = world::parseDoorSelection(environment, closed_doors_, "~closed_doors");
+    truth_ = world::renderEnvironment(environment, closed).map;
     // Walls rasterized finer for the clearance (the 5 cm rendering's cells stick out of the walls by up to a cell).
-    RenderOptions fine;
+    world::RenderOptions fine;
     fine.resolution = clearance_resolution_;
-    fine_truth_ = renderEnvironment(environment, closed, fine).map;
+    fine_truth_ = world::renderEnvironment(environment, closed, fine).map;
     cv::Mat1b not_wall = (fine_truth_.cells < 65);
     cv::distanceTransform(not_wall, wall_distance_, cv::DIST_L2, cv::DIST_MASK_PRECISE);
     wall_distance_ *= static_cast<float>(fine_truth_.resolution);
@@ -85,7 +85,7 @@ class ExplorerTest : public ::testing::Test {
   }
 
   void onTruth(const nav_msgs::Odometry& message) {
-    const Pose2 pose = fromRos(message.pose.pose);
+    const common::Pose2 pose = fromRos(message.pose.pose);
     const double time = message.header.stamp.toSec();
     if (!truth_pose_) {
       start_ = pose;
@@ -101,7 +101,7 @@ class ExplorerTest : public ::testing::Test {
     const double c = std::cos(pose.yaw), s = std::sin(pose.yaw);
     const auto check = [&](double x, double y) {
       int col = 0, row = 0;
-      if (!fine_truth_.cellOf(Point2(pose.x + c * x - s * y, pose.y + s * x + c * y), &col, &row)) return;
+      if (!fine_truth_.cellOf(common::Point2(pose.x + c * x - s * y, pose.y + s * x + c * y), &col, &row)) return;
       const double clearance = wall_distance_(row, col) - 0.5 * fine_truth_.resolution;
       if (clearance < figures_.min_clearance) {
         figures_.min_clearance = clearance;
@@ -134,22 +134,23 @@ class ExplorerTest : public ::testing::Test {
     tf2_ros::Buffer& buffer = *tf_buffer_;
     geometry_msgs::TransformStamped map_pose;
     ASSERT_NO_THROW(map_pose = buffer.lookupTransform(map_frame_, base_frame_, truth_stamp_, ros::Duration(5.0)));
-    const Pose2 world_from_map = composePoses(*truth_pose_, invertPose(fromRos(map_pose.transform)));
+    const common::Pose2 world_from_map =
+        common::composePoses(*truth_pose_, common::invertPose(fromRos(map_pose.transform)));
 
     int col = 0, row = 0;
-    ASSERT_TRUE(truth_.cellOf(Point2(start_.x, start_.y), &col, &row));
-    cv::Mat1b free_cells = (truth_.cells == OccupancyGrid::kFree);
+    ASSERT_TRUE(truth_.cellOf(common::Point2(start_.x, start_.y), &col, &row));
+    cv::Mat1b free_cells = (truth_.cells == common::OccupancyGrid::kFree);
     cv::Mat1b mask = cv::Mat1b::zeros(truth_.height() + 2, truth_.width() + 2);
     ASSERT_NE(free_cells(row, col), 0) << "the start is not on a free cell of the rendering";
     cv::floodFill(free_cells, mask, cv::Point(col, row), 128, nullptr, 0, 0, 4 | cv::FLOODFILL_MASK_ONLY | (255 << 8));
     const cv::Mat1b reachable = mask(cv::Rect(1, 1, truth_.width(), truth_.height())).clone();
-    const OccupancyGrid map = fromRos(*map_);
+    const common::OccupancyGrid map = fromRos(*map_);
     if (!map_prefix_.empty()) {
-      saveMap(map, map_prefix_);
+      common::saveMap(map, map_prefix_);
       std::ofstream(map_prefix_ + "_world_from_map.txt")
           << world_from_map.x << " " << world_from_map.y << " " << world_from_map.yaw << "\n";
     }
-    const MapQuality quality = evaluateMap(map, world_from_map, truth_, reachable);
+    const evaluation::MapQuality quality = evaluation::evaluateMap(map, world_from_map, truth_, reachable);
     figures_.reachable_cells = quality.true_free_cells;
     figures_.coverage = quality.true_free_cells > 0
                             ? static_cast<double>(quality.intersection_cells) / quality.true_free_cells
@@ -162,13 +163,13 @@ class ExplorerTest : public ::testing::Test {
   double wall_time_limit_ = 150.0, min_coverage_ = 0.95, max_stall_ = 30.0;
   double footprint_length_ = 0.626, footprint_width_ = 0.505;
   double clearance_resolution_ = 0.01;
-  OccupancyGrid truth_, fine_truth_;
+  common::OccupancyGrid truth_, fine_truth_;
   cv::Mat1f wall_distance_;
   bool done_ = false;
   nav_msgs::OccupancyGrid::ConstPtr map_;
-  std::optional<Pose2> truth_pose_;
+  std::optional<common::Pose2> truth_pose_;
   ros::Time truth_stamp_;
-  Pose2 start_, stall_anchor_;
+  common::Pose2 start_, stall_anchor_;
   double stall_anchor_time_ = 0.0;
   Figures figures_;
   std::unique_ptr<tf2_ros::Buffer> tf_buffer_ = std::make_unique<tf2_ros::Buffer>(ros::Duration(60.0));

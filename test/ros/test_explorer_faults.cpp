@@ -35,7 +35,7 @@ struct TimedCommand {
 
 struct TimedPosition {
   double time = 0.0;
-  Point2 position = Point2::Zero();
+  common::Point2 position = common::Point2::Zero();
 };
 
 class ExplorerFaultsTest : public ::testing::Test {
@@ -47,20 +47,19 @@ class ExplorerFaultsTest : public ::testing::Test {
     private_nh.param("map_timeout", map_timeout_, map_timeout_);
     // The world as rendered, everything below the corridor's wall line (y < 3.95 m: the rooms) unknown; the
     // open doorways in that wall are free cells next to the unknown rooms.
-    map_ = renderEnvironment(loadEnvironment(world), {}).map;
+    map_ = world::renderEnvironment(world::loadEnvironment(world), {}).map;
     for (int row = 0; row < map_.height(); ++row)
       for (int col = 0; col < map_.width(); ++col)
-        if (map_.cellCentre(col, row).y() < 3.95) map_.cells(row, col) = OccupancyGrid::kUnknown;
+        if (map_.cellCentre(col, row).y() < 3.95) map_.cells(row, col) = common::OccupancyGrid::kUnknown;
 
     map_publisher_ = nh_.advertise<nav_msgs::OccupancyGrid>("map", 1, true);
     command_publisher_ = nh_.advertise<geometry_msgs::Twist>("cmd_vel", 10);
     command_subscriber_ = nh_.subscribe("explorer_cmd_vel", 100, &ExplorerFaultsTest::onCommand, this);
-    truth_subscriber_ = nh_.subscribe<nav_msgs::Odometry>("base_pose_ground_truth", 100,
-                                                         [this](const nav_msgs::Odometry::ConstPtr& m) {
-                                                           const Pose2 pose = fromRos(m->pose.pose);
-                                                           positions_.push_back({m->header.stamp.toSec(),
-                                                                                 Point2(pose.x, pose.y)});
-                                                         });
+    truth_subscriber_ =
+        nh_.subscribe<nav_msgs::Odometry>("base_pose_ground_truth", 100, [this](const nav_msgs::Odometry::ConstPtr& m) {
+          const common::Pose2 pose = fromRos(m->pose.pose);
+          positions_.push_back({m->header.stamp.toSec(), common::Point2(pose.x, pose.y)});
+        });
     done_subscriber_ = nh_.subscribe<std_msgs::Bool>("exploration_done", 10, [this](const std_msgs::Bool::ConstPtr& m) {
       done_ = m->data;
       if (m->data && pinned_) done_while_pinned_ = true;
@@ -89,12 +88,12 @@ class ExplorerFaultsTest : public ::testing::Test {
     return waitFor([&] { return ros::Time::now().toSec() >= time; }, wall_seconds);
   }
 
-  std::optional<Point2> position() const {
-    return positions_.empty() ? std::nullopt : std::optional<Point2>(positions_.back().position);
+  std::optional<common::Point2> position() const {
+    return positions_.empty() ? std::nullopt : std::optional<common::Point2>(positions_.back().position);
   }
   // The largest distance between two true positions logged within [from, to] (simulated seconds).
   double motionBetween(double from, double to) const {
-    std::optional<Point2> first;
+    std::optional<common::Point2> first;
     double motion = 0.0;
     for (const TimedPosition& p : positions_) {
       if (p.time < from || p.time > to) continue;
@@ -103,7 +102,7 @@ class ExplorerFaultsTest : public ::testing::Test {
     }
     return motion;
   }
-  bool movedFrom(const Point2& origin, double distance) const {
+  bool movedFrom(const common::Point2& origin, double distance) const {
     return position() && (*position() - origin).norm() >= distance;
   }
 
@@ -120,7 +119,7 @@ class ExplorerFaultsTest : public ::testing::Test {
 
   ros::NodeHandle nh_;
   double map_timeout_ = 2.0;
-  OccupancyGrid map_;
+  common::OccupancyGrid map_;
   bool map_alive_ = true;
   ros::Time last_map_;
   bool pinned_ = false;
@@ -136,7 +135,7 @@ class ExplorerFaultsTest : public ::testing::Test {
 TEST_F(ExplorerFaultsTest, StopsWithoutMapsAndRecoversWhenPinned) {
   // Exploring: the robot drives towards a doorway.
   ASSERT_TRUE(waitFor([this] { return position().has_value(); }, 30.0)) << "no ground truth from the simulator";
-  const Point2 start = *position();
+  const common::Point2 start = *position();
   ASSERT_TRUE(waitFor([&] { return movedFrom(start, 0.3); }, 30.0)) << "the explorer did not drive";
 
   // 1. No map for 11 simulated seconds: the robot stands still for more than 8 s, beyond the follower's
@@ -157,7 +156,7 @@ TEST_F(ExplorerFaultsTest, StopsWithoutMapsAndRecoversWhenPinned) {
 
   map_alive_ = true;
   const double resumed = ros::Time::now().toSec();
-  const Point2 resumed_at = *position();
+  const common::Point2 resumed_at = *position();
   ASSERT_TRUE(waitFor([&] { return movedFrom(resumed_at, 0.3); }, 20.0)) << "no driving when the map came back";
   for (const TimedCommand& command : commands_) {
     if (command.time < resumed || command.time > resumed + 1.5) continue;
@@ -187,7 +186,7 @@ TEST_F(ExplorerFaultsTest, StopsWithoutMapsAndRecoversWhenPinned) {
   EXPECT_FALSE(done_while_pinned_) << "exploration_done while the robot was only stuck";
 
   pinned_ = false;
-  const Point2 freed_at = *position();
+  const common::Point2 freed_at = *position();
   EXPECT_TRUE(waitFor([&] { return movedFrom(freed_at, 0.3); }, 30.0)) << "no driving once the robot was free";
   std::printf("pause %.1f..%.1f s, pinned %.1f..%.1f s, %zu commands, path from (%.2f, %.2f) to (%.2f, %.2f)\n",
               stale, resumed, pinned, ros::Time::now().toSec(), commands_.size(), start.x(), start.y(),

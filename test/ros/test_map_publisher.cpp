@@ -10,11 +10,12 @@
 
 namespace {
 
-hidden_rooms::OccupancyGrid expectedMap() {
+hidden_rooms::common::OccupancyGrid expectedMap() {
   std::string environment_path;
   ros::NodeHandle("~").getParam("environment", environment_path);
-  const hidden_rooms::Environment environment = hidden_rooms::loadEnvironment(environment_path);
-  return hidden_rooms::renderEnvironment(environment, {0, 1}).map;  // doors 1 and 2 closed, as in the launch file
+  const hidden_rooms::world::Environment environment = hidden_rooms::world::loadEnvironment(environment_path);
+  return hidden_rooms::world::renderEnvironment(environment, {0, 1})
+      .map;  // doors 1 and 2 closed, as in the launch file
 }
 
 TEST(MapPublisher, PublishesTheRenderedWorldLatched) {
@@ -23,15 +24,15 @@ TEST(MapPublisher, PublishesTheRenderedWorldLatched) {
       ros::topic::waitForMessage<nav_msgs::OccupancyGrid>("map", nh, ros::Duration(30.0));
   ASSERT_TRUE(map != nullptr) << "no map within 30 s";
   EXPECT_EQ(map->header.frame_id, "map");
-  const hidden_rooms::OccupancyGrid expected = expectedMap();
-  const hidden_rooms::OccupancyGrid received = hidden_rooms::fromRos(*map);
+  const hidden_rooms::common::OccupancyGrid expected = expectedMap();
+  const hidden_rooms::common::OccupancyGrid received = hidden_rooms::fromRos(*map);
   ASSERT_EQ(received.width(), expected.width());
   ASSERT_EQ(received.height(), expected.height());
   EXPECT_NEAR(received.resolution, expected.resolution, 1e-6);
   EXPECT_NEAR(received.origin.x(), expected.origin.x(), 1e-9);
   EXPECT_NEAR(received.origin.y(), expected.origin.y(), 1e-9);
   EXPECT_EQ(cv::countNonZero(received.cells != expected.cells), 0);
-  EXPECT_GT(cv::countNonZero(received.cells == hidden_rooms::OccupancyGrid::kFree), 1000);
+  EXPECT_GT(cv::countNonZero(received.cells == hidden_rooms::common::OccupancyGrid::kFree), 1000);
 }
 
 TEST(MapPublisher, ServesStaticMap) {

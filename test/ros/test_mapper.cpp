@@ -48,7 +48,8 @@ class MapperTest : public ::testing::Test {
   // The wander's command for each scan while driving; zero afterwards.
   void onScan(const sensor_msgs::LaserScan::ConstPtr& scan) {
     scans_.push_back(scan);
-    const VelocityCommand command = driving_ ? driver_.next(scan->ranges, laserGeometryOf(*scan)) : VelocityCommand();
+    const common::VelocityCommand command =
+        driving_ ? driver_.next(scan->ranges, laserGeometryOf(*scan)) : common::VelocityCommand();
     command_publisher_.publish(toRos(command));
   }
 
@@ -60,7 +61,7 @@ class MapperTest : public ::testing::Test {
   double truthTime() const { return truth_.empty() ? 0.0 : truth_.back()->header.stamp.toSec(); }
 
   // The true pose at `time`: the nearest recorded one (20 Hz).
-  Pose2 truthAt(const ros::Time& time) const {
+  common::Pose2 truthAt(const ros::Time& time) const {
     const auto nearest = std::min_element(truth_.begin(), truth_.end(), [&](const auto& a, const auto& b) {
       return std::abs((a->header.stamp - time).toSec()) < std::abs((b->header.stamp - time).toSec());
     });
@@ -73,7 +74,7 @@ class MapperTest : public ::testing::Test {
   std::string world_;
   double drive_seconds_ = 40.0;
   bool driving_ = true;
-  WanderDriver driver_;
+  simulation::WanderDriver driver_;
   ros::Publisher command_publisher_;
   ros::Subscriber scan_subscriber_, truth_subscriber_, map_subscriber_, metadata_subscriber_;
   std::vector<sensor_msgs::LaserScan::ConstPtr> scans_;
@@ -115,18 +116,19 @@ TEST_F(MapperTest, MapsTheWorldPublishesTfAndSavesTheMap) {
   geometry_msgs::TransformStamped map_to_base;
   ASSERT_TRUE(waitFor([&] { return tf_buffer_.canTransform("map", "odom", ros::Time(0)); }, 5.0)) << "no map -> odom";
   ASSERT_NO_THROW(map_to_base = tf_buffer_.lookupTransform("map", "base_link", ros::Time(0)));
-  const Pose2 laser_mount = fromRos(tf_buffer_.lookupTransform("base_link", scans_.back()->header.frame_id,
-                                                               ros::Time(0)).transform);
+  const common::Pose2 laser_mount =
+      fromRos(tf_buffer_.lookupTransform("base_link", scans_.back()->header.frame_id, ros::Time(0)).transform);
 
   // Quality against the rendered ground truth, aligned by the final map -> world transform; only the free cells
   // the scans crossed count.
-  const RenderedEnvironment truth = renderEnvironment(loadEnvironment(world_), {});
-  const Pose2 world_from_map = composePoses(truthAt(map_to_base.header.stamp), invertPose(fromRos(map_to_base.transform)));
+  const world::RenderedEnvironment truth = world::renderEnvironment(world::loadEnvironment(world_), {});
+  const common::Pose2 world_from_map =
+      common::composePoses(truthAt(map_to_base.header.stamp), common::invertPose(fromRos(map_to_base.transform)));
   cv::Mat1b observed;
   for (const auto& scan : scans_)
-    markObservedCells(truth.map, composePoses(truthAt(scan->header.stamp), laser_mount), fromRos(*scan, laser_mount),
-                      &observed);
-  const MapQuality quality = evaluateMap(fromRos(*map_), world_from_map, truth.map, observed);
+    evaluation::markObservedCells(truth.map, common::composePoses(truthAt(scan->header.stamp), laser_mount),
+                                  fromRos(*scan, laser_mount), &observed);
+  const evaluation::MapQuality quality = evaluation::evaluateMap(fromRos(*map_), world_from_map, truth.map, observed);
   std::printf("scans %zu, free IoU %.3f (true %lld, map %lld), walls within 2 cells %.3f\n", scans_.size(),
               quality.free_iou, quality.true_free_cells, quality.map_free_cells, quality.walls_within_2_cells);
   EXPECT_GE(quality.free_iou, 0.85);  // measured 0.95
@@ -140,8 +142,8 @@ TEST_F(MapperTest, MapsTheWorldPublishesTfAndSavesTheMap) {
   ASSERT_TRUE(save.response.success) << save.response.message;
   EXPECT_EQ(save.response.message, prefix + ".yaml");
   ros::spinOnce();
-  const OccupancyGrid published = fromRos(*map_);
-  const OccupancyGrid saved = loadMap(prefix + ".yaml");
+  const common::OccupancyGrid published = fromRos(*map_);
+  const common::OccupancyGrid saved = common::loadMap(prefix + ".yaml");
   EXPECT_DOUBLE_EQ(saved.resolution, 0.05);
   EXPECT_GE(saved.width(), published.width());  // the map may have grown since the last publication
   EXPECT_GE(saved.height(), published.height());

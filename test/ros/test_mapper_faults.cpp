@@ -72,7 +72,8 @@ class MapperFaultsTest : public ::testing::Test {
   }
 
   void onScan(const sensor_msgs::LaserScan::ConstPtr& scan) {
-    const VelocityCommand command = driving_ ? driver_.next(scan->ranges, laserGeometryOf(*scan)) : VelocityCommand();
+    const common::VelocityCommand command =
+        driving_ ? driver_.next(scan->ranges, laserGeometryOf(*scan)) : common::VelocityCommand();
     command_publisher_.publish(toRos(command));
     if (relaying_) relay(scan);
   }
@@ -123,20 +124,20 @@ class MapperFaultsTest : public ::testing::Test {
     return count;
   }
 
-  OccupancyGrid savedMap(const std::string& service, const std::string& prefix) {
+  common::OccupancyGrid savedMap(const std::string& service, const std::string& prefix) {
     hidden_rooms::SaveMap save;
     save.request.prefix = prefix;
     EXPECT_TRUE(ros::service::waitForService(service, ros::Duration(10.0))) << service;
     EXPECT_TRUE(ros::service::call(service, save)) << service;
     EXPECT_TRUE(save.response.success) << service << ": " << save.response.message;
-    return save.response.success ? loadMap(prefix + ".yaml") : OccupancyGrid();
+    return save.response.success ? common::loadMap(prefix + ".yaml") : common::OccupancyGrid();
   }
 
   ros::NodeHandle nh_;
   double drive_seconds_ = 18.0;
   bool driving_ = false;
   bool relaying_ = false;
-  WanderDriver driver_;
+  simulation::WanderDriver driver_;
   ros::Publisher command_publisher_, clean_publisher_, faulty_publisher_;
   ros::Subscriber scan_subscriber_, faulty_map_subscriber_, rosout_subscriber_;
   std::vector<sensor_msgs::LaserScan::ConstPtr> relayed_;
@@ -174,12 +175,12 @@ TEST_F(MapperFaultsTest, BadScansAreIgnoredAndTheMapIsTheCleanOne) {
 
   // (b) its map is the clean mapper's, cell for cell.
   const std::string dir = testing::makeTempDir("mapper_faults");
-  const OccupancyGrid clean = savedMap("/clean/save_map", dir + "/clean");
-  const OccupancyGrid faulty = savedMap("/faulty/save_map", dir + "/faulty");
+  const common::OccupancyGrid clean = savedMap("/clean/save_map", dir + "/clean");
+  const common::OccupancyGrid faulty = savedMap("/faulty/save_map", dir + "/faulty");
   ASSERT_FALSE(clean.empty());
   ASSERT_FALSE(faulty.empty());
-  EXPECT_GT(cv::countNonZero(clean.cells == OccupancyGrid::kFree), 1000);
-  EXPECT_GT(cv::countNonZero(clean.cells == OccupancyGrid::kOccupied), 100);
+  EXPECT_GT(cv::countNonZero(clean.cells == common::OccupancyGrid::kFree), 1000);
+  EXPECT_GT(cv::countNonZero(clean.cells == common::OccupancyGrid::kOccupied), 100);
   ASSERT_EQ(faulty.cells.size(), clean.cells.size()) << "the maps differ in size";
   EXPECT_DOUBLE_EQ(faulty.origin.x(), clean.origin.x());
   EXPECT_DOUBLE_EQ(faulty.origin.y(), clean.origin.y());

@@ -34,7 +34,7 @@ double beamDirection(const mrpt::obs::CObservation2DRangeScan& scan, size_t i) {
 
 TEST(MrptScan, KeepsEveryBeamAtItsDirection) {
   const sensor_msgs::LaserScan message = simulatorScan();
-  const mrpt::obs::CObservation2DRangeScan scan = toMrptScan(message, Pose2{0.2, 0.0, 0.0});
+  const mrpt::obs::CObservation2DRangeScan scan = toMrptScan(message, common::Pose2{0.2, 0.0, 0.0});
   ASSERT_EQ(scan.getScanSize(), 1081u);
   EXPECT_NEAR(scan.sensorPose.x(), 0.2, 1e-9);
   EXPECT_FLOAT_EQ(scan.maxRange, 30.0f);
@@ -53,7 +53,7 @@ TEST(MrptScan, AsymmetricAndClockwiseScansKeepTheirDirections) {
   message.angle_increment = 0.01f;
   message.range_max = 10.0f;
   message.ranges = {1.0f, 2.0f, 3.0f, 4.0f, 5.0f};
-  const auto forward = toMrptScan(message, Pose2{0.0, 0.0, 0.5});
+  const auto forward = toMrptScan(message, common::Pose2{0.0, 0.0, 0.5});
   for (size_t i = 0; i < 5; ++i) {
     EXPECT_FLOAT_EQ(forward.getScanRange(i), message.ranges[i]);
     EXPECT_NEAR(beamDirection(forward, i), 0.5 + 0.1 + 0.01 * i, 1e-6);
@@ -62,7 +62,7 @@ TEST(MrptScan, AsymmetricAndClockwiseScansKeepTheirDirections) {
   message.angle_min = 0.14f;
   message.angle_increment = -0.01f;
   message.ranges = {5.0f, 4.0f, 3.0f, 2.0f, 1.0f};
-  const auto backward = toMrptScan(message, Pose2{0.0, 0.0, 0.5});
+  const auto backward = toMrptScan(message, common::Pose2{0.0, 0.0, 0.5});
   for (size_t i = 0; i < 5; ++i) {
     EXPECT_FLOAT_EQ(backward.getScanRange(i), forward.getScanRange(i));
     EXPECT_NEAR(beamDirection(backward, i), beamDirection(forward, i), 1e-6);
@@ -76,7 +76,7 @@ TEST(MrptScan, NanInfinityAndOutOfRangeBeamsAreInvalid) {
   message.ranges[12] = -std::numeric_limits<float>::infinity();
   message.ranges[13] = 0.01f;   // below range_min
   message.ranges[14] = 30.0f;   // no return
-  const auto scan = toMrptScan(message, Pose2{});
+  const auto scan = toMrptScan(message, common::Pose2{});
   for (size_t i = 10; i <= 14; ++i) {
     EXPECT_FALSE(scan.getScanRangeValidity(i)) << i;
     EXPECT_TRUE(std::isfinite(scan.getScanRange(i))) << i;
@@ -91,14 +91,14 @@ TEST(MrptScan, NanInfinityAndOutOfRangeBeamsAreInvalid) {
 TEST(MrptScan, BadMessagesGiveClearErrors) {
   sensor_msgs::LaserScan message = simulatorScan();
   message.ranges.resize(1);
-  EXPECT_THROW(toMrptScan(message, Pose2{}), InputError);
+  EXPECT_THROW(toMrptScan(message, common::Pose2{}), common::InputError);
   message = simulatorScan();
   message.angle_increment = 0.0f;
-  EXPECT_THROW(toMrptScan(message, Pose2{}), InputError);
+  EXPECT_THROW(toMrptScan(message, common::Pose2{}), common::InputError);
   message = simulatorScan();
   message.range_max = std::numeric_limits<float>::quiet_NaN();
-  EXPECT_THROW(toMrptScan(message, Pose2{}), InputError);
-  EXPECT_THROW(toMrptScan(simulatorScan(), Pose2{std::nan(""), 0.0, 0.0}), InputError);
+  EXPECT_THROW(toMrptScan(message, common::Pose2{}), common::InputError);
+  EXPECT_THROW(toMrptScan(simulatorScan(), common::Pose2{std::nan(""), 0.0, 0.0}), common::InputError);
 }
 
 }  // namespace

@@ -39,13 +39,13 @@ TEST(PoseLogger, LogsTheEstimateAndTheTruthEveryPeriod) {
   ASSERT_NE(truth, nullptr) << "no ground truth from the simulator";
   ASSERT_GE(truth->header.stamp.toSec(), start_time + 5.0) << "simulated time did not advance";
 
-  const hidden_rooms::PoseLog estimate = hidden_rooms::loadPoseLog(log_dir + "/poses_map.log");
-  const hidden_rooms::PoseLog ground_truth = hidden_rooms::loadPoseLog(log_dir + "/poses_truth.log");
+  const hidden_rooms::common::PoseLog estimate = hidden_rooms::common::loadPoseLog(log_dir + "/poses_map.log");
+  const hidden_rooms::common::PoseLog ground_truth = hidden_rooms::common::loadPoseLog(log_dir + "/poses_truth.log");
   EXPECT_EQ(estimate.parent_frame, "map");
   EXPECT_EQ(estimate.child_frame, "base_link");
   EXPECT_EQ(ground_truth.parent_frame, "world");
   // About one pose per 0.1 s (the logger may start a little after the simulator).
-  for (const hidden_rooms::PoseLog* log : {&estimate, &ground_truth}) {
+  for (const hidden_rooms::common::PoseLog* log : {&estimate, &ground_truth}) {
     ASSERT_GE(log->poses.size(), 50u);
     for (size_t k = 1; k < log->poses.size(); ++k) {
       const double step = log->poses[k].time - log->poses[k - 1].time;
@@ -55,9 +55,9 @@ TEST(PoseLogger, LogsTheEstimateAndTheTruthEveryPeriod) {
   }
   // The estimate is the odometry seen from a map frame shifted against odom: over the drive, both logs move by
   // the same 1.5 m (up to the odometry drift).
-  const auto displacement = [start_time](const hidden_rooms::PoseLog& log) {
-    const hidden_rooms::Pose2 before = hidden_rooms::poseAt(log.poses, start_time);
-    const hidden_rooms::Pose2 after = log.poses.back().pose;
+  const auto displacement = [start_time](const hidden_rooms::common::PoseLog& log) {
+    const hidden_rooms::common::Pose2 before = hidden_rooms::common::poseAt(log.poses, start_time);
+    const hidden_rooms::common::Pose2 after = log.poses.back().pose;
     return std::hypot(after.x - before.x, after.y - before.y);
   };
   EXPECT_NEAR(displacement(ground_truth), 1.5, 0.3);
@@ -75,7 +75,7 @@ void spinSimulated(double seconds) {
 }
 
 int headerCount(const std::string& path) {
-  const std::string text = hidden_rooms::readTextFile(path, "log");
+  const std::string text = hidden_rooms::common::readTextFile(path, "log");
   int count = 0;
   for (size_t at = text.find("# frame:"); at != std::string::npos; at = text.find("# frame:", at + 1)) ++count;
   return count;
@@ -108,16 +108,16 @@ TEST(PoseLogger, ARestartedLoggerContinuesItsLogs) {
     ASSERT_GT(logger.estimatesLogged(), 5);
   }
   for (const std::string& path : {options.estimate_log, options.ground_truth_log}) {
-    hidden_rooms::PoseLog log;
-    ASSERT_NO_THROW(log = hidden_rooms::loadPoseLog(path)) << path;  // times increase, no cut line
+    hidden_rooms::common::PoseLog log;
+    ASSERT_NO_THROW(log = hidden_rooms::common::loadPoseLog(path)) << path;  // times increase, no cut line
     EXPECT_EQ(headerCount(path), 1) << path;
     ASSERT_GE(log.poses.size(), 20u) << path;
     size_t before = 0, after = 0;
-    for (const hidden_rooms::TimedPose& pose : log.poses) (pose.time < restart ? before : after) += 1;
+    for (const hidden_rooms::common::TimedPose& pose : log.poses) (pose.time < restart ? before : after) += 1;
     EXPECT_GE(before, 10u) << path << ": the first run's poses";
     EXPECT_GE(after, 10u) << path << ": the second run's poses";
   }
-  EXPECT_EQ(hidden_rooms::loadPoseLog(options.ground_truth_log).parent_frame, "world");
+  EXPECT_EQ(hidden_rooms::common::loadPoseLog(options.ground_truth_log).parent_frame, "world");
 }
 
 }  // namespace

@@ -70,8 +70,8 @@ std::string runOffline(const std::string& method) {
 
 TEST(RoomPredictor, ServiceGivesTheOfflineCommandsRooms) {
   REQUIRE_CASE();
-  const hidden_rooms::OccupancyGrid map = hidden_rooms::loadMap(caseDir() + "/map.yaml");
-  const hidden_rooms::DoorsFile doors = hidden_rooms::loadDoors(caseDir() + "/doors.yaml");
+  const hidden_rooms::common::OccupancyGrid map = hidden_rooms::common::loadMap(caseDir() + "/map.yaml");
+  const hidden_rooms::common::DoorsFile doors = hidden_rooms::common::loadDoors(caseDir() + "/doors.yaml");
   for (const std::string method : {"default", "thesis"}) {
     SCOPED_TRACE(method);
     PredictRooms service;
@@ -85,10 +85,10 @@ TEST(RoomPredictor, ServiceGivesTheOfflineCommandsRooms) {
     EXPECT_EQ(service.response.completed_map.header.frame_id, "map");
 
     const std::string offline = runOffline(method);
-    std::vector<hidden_rooms::RoomPrediction> rooms;
+    std::vector<hidden_rooms::prediction::RoomPrediction> rooms;
     for (const hidden_rooms::PredictedRoom& room : service.response.rooms)
       rooms.push_back(hidden_rooms::fromRos(room, map));
-    const cv::Mat1w labels = hidden_rooms::roomLabels(map, doors, rooms);
+    const cv::Mat1w labels = hidden_rooms::prediction::roomLabels(map, doors, rooms);
     const cv::Mat expected = cv::imread(offline + "/rooms.png", cv::IMREAD_UNCHANGED);
     ASSERT_FALSE(expected.empty());
     cv::Mat1w expected_labels;
@@ -96,8 +96,8 @@ TEST(RoomPredictor, ServiceGivesTheOfflineCommandsRooms) {
     EXPECT_EQ(cv::countNonZero(labels != expected_labels), 0) << "rooms differ from predict_rooms_offline's";
     EXPECT_GT(cv::countNonZero(labels), 1000);
 
-    const hidden_rooms::OccupancyGrid completed = hidden_rooms::fromRos(service.response.completed_map);
-    const hidden_rooms::OccupancyGrid expected_completed = hidden_rooms::loadMap(offline + "/map.yaml");
+    const hidden_rooms::common::OccupancyGrid completed = hidden_rooms::fromRos(service.response.completed_map);
+    const hidden_rooms::common::OccupancyGrid expected_completed = hidden_rooms::common::loadMap(offline + "/map.yaml");
     ASSERT_EQ(completed.cells.size(), expected_completed.cells.size());
     EXPECT_EQ(completed.resolution, expected_completed.resolution);
     EXPECT_EQ(completed.origin, expected_completed.origin);
@@ -152,7 +152,7 @@ TEST(RoomPredictor, EmptyRequestUsesTheDoorsFileAndTheNodesMethod) {
   ASSERT_TRUE(call(&service));
   ASSERT_TRUE(service.response.success) << service.response.message;
   EXPECT_EQ(service.response.method, "default");
-  EXPECT_EQ(service.response.rooms.size(), hidden_rooms::loadDoors(caseDir() + "/doors.yaml").doors.size());
+  EXPECT_EQ(service.response.rooms.size(), hidden_rooms::common::loadDoors(caseDir() + "/doors.yaml").doors.size());
 }
 
 TEST(RoomPredictor, PublishesLatchedOverlays) {
@@ -161,7 +161,7 @@ TEST(RoomPredictor, PublishesLatchedOverlays) {
   // ~predict_on_map: the node predicted the file's doors as soon as the map arrived.
   const auto completed = ros::topic::waitForMessage<nav_msgs::OccupancyGrid>("predicted_map", nh, ros::Duration(30.0));
   ASSERT_TRUE(completed != nullptr);
-  const hidden_rooms::OccupancyGrid map = hidden_rooms::loadMap(caseDir() + "/map.yaml");
+  const hidden_rooms::common::OccupancyGrid map = hidden_rooms::common::loadMap(caseDir() + "/map.yaml");
   EXPECT_EQ(completed->info.width, static_cast<uint32_t>(map.width()));
   EXPECT_EQ(completed->info.height, static_cast<uint32_t>(map.height()));
   const auto markers =
@@ -194,9 +194,10 @@ TEST(RoomPredictor, WritesTheCompletedMapAsAnOctomap) {
   while (!std::filesystem::exists(path) && ros::WallTime::now() < deadline) ros::WallDuration(0.1).sleep();
   ASSERT_TRUE(std::filesystem::exists(path)) << "no 3D map written";
   // Its band between floor and ceiling is the completed map, cut to its known cells.
-  const hidden_rooms::OccupancyGrid map = hidden_rooms::fromRos(*completed);
-  const hidden_rooms::OccupancyGrid sliced = hidden_rooms::sliceOctomap(path, hidden_rooms::SliceOptions());
-  const cv::Rect known = cv::boundingRect(map.cells != hidden_rooms::OccupancyGrid::kUnknown);
+  const hidden_rooms::common::OccupancyGrid map = hidden_rooms::fromRos(*completed);
+  const hidden_rooms::common::OccupancyGrid sliced =
+      hidden_rooms::map3d::sliceOctomap(path, hidden_rooms::map3d::SliceOptions());
+  const cv::Rect known = cv::boundingRect(map.cells != hidden_rooms::common::OccupancyGrid::kUnknown);
   ASSERT_EQ(sliced.cells.size(), known.size());
   EXPECT_EQ(cv::countNonZero(sliced.cells != map.cells(known)), 0);
 }
@@ -213,7 +214,7 @@ void expectFailure(PredictRooms* service, const std::vector<std::string>& words,
 
 TEST(RoomPredictor, BadRequestsFailWithAMessageAndTheNodeKeepsServing) {
   REQUIRE_CASE();
-  const hidden_rooms::DoorsFile doors = hidden_rooms::loadDoors(caseDir() + "/doors.yaml");
+  const hidden_rooms::common::DoorsFile doors = hidden_rooms::common::loadDoors(caseDir() + "/doors.yaml");
   {
     SCOPED_TRACE("door outside the map");
     PredictRooms service;
@@ -225,8 +226,8 @@ TEST(RoomPredictor, BadRequestsFailWithAMessageAndTheNodeKeepsServing) {
     SCOPED_TRACE("map with no known cell");
     PredictRooms service;
     service.request.doors = hidden_rooms::toRos(doors);
-    hidden_rooms::OccupancyGrid empty;
-    empty.cells = cv::Mat_<int8_t>(400, 400, hidden_rooms::OccupancyGrid::kUnknown);
+    hidden_rooms::common::OccupancyGrid empty;
+    empty.cells = cv::Mat_<int8_t>(400, 400, hidden_rooms::common::OccupancyGrid::kUnknown);
     service.request.map = hidden_rooms::toRos(empty, "map", ros::Time::now());
     expectFailure(&service, {"map", "no known cell"});
   }
@@ -234,8 +235,8 @@ TEST(RoomPredictor, BadRequestsFailWithAMessageAndTheNodeKeepsServing) {
     SCOPED_TRACE("map with no free cell");
     PredictRooms service;
     service.request.doors = hidden_rooms::toRos(doors);
-    hidden_rooms::OccupancyGrid walls = hidden_rooms::loadMap(caseDir() + "/map.yaml");
-    walls.cells.setTo(hidden_rooms::OccupancyGrid::kOccupied);
+    hidden_rooms::common::OccupancyGrid walls = hidden_rooms::common::loadMap(caseDir() + "/map.yaml");
+    walls.cells.setTo(hidden_rooms::common::OccupancyGrid::kOccupied);
     service.request.map = hidden_rooms::toRos(walls, "map", ros::Time::now());
     expectFailure(&service, {"map", "no free cell"});
   }
@@ -304,13 +305,15 @@ TEST(RoomPredictor, BadRequestsFailWithAMessageAndTheNodeKeepsServing) {
     service.request.doors = hidden_rooms::toRos(doors);
     expectFailure(&service, {"no map", "/no_map/map"}, "/no_map/predict_rooms");
     PredictRooms no_doors;
-    no_doors.request.map = hidden_rooms::toRos(hidden_rooms::loadMap(caseDir() + "/map.yaml"), "map", ros::Time::now());
+    no_doors.request.map =
+        hidden_rooms::toRos(hidden_rooms::common::loadMap(caseDir() + "/map.yaml"), "map", ros::Time::now());
     expectFailure(&no_doors, {"no doors", "closed_doors_file"}, "/no_map/predict_rooms");
   }
   // Still serving, and a good request with its own map and a parameter override works.
   PredictRooms service;
   service.request.doors = hidden_rooms::toRos(doors);
-  service.request.map = hidden_rooms::toRos(hidden_rooms::loadMap(caseDir() + "/map.yaml"), "map", ros::Time::now());
+  service.request.map =
+      hidden_rooms::toRos(hidden_rooms::common::loadMap(caseDir() + "/map.yaml"), "map", ros::Time::now());
   service.request.method = "thesis";
   hidden_rooms::PredictionParameter parameter;
   parameter.name = "thesis_depth";

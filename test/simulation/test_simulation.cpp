@@ -13,16 +13,16 @@
 #include "hidden_rooms/world/render.h"
 #include "test_util.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::simulation {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
 // corridorWithTwoRoomsXml(): corridor x 0..10, y 4..6 m; room A x 0..4, room B x 4..10, y 0..4; door 1 at
 // (2, 4) into A, door 2 at (7, 4) into B; walls 0.15 m thick, doors 0.9 m wide.
-Environment corridorWorld() { return parseEnvironment(testing::corridorWithTwoRoomsXml(), "synthetic"); }
+world::Environment corridorWorld() { return world::parseEnvironment(testing::corridorWithTwoRoomsXml(), "synthetic"); }
 
-SimulationOptions quietOptions(const Pose2& start, LaserCasterKind caster = LaserCasterKind::kBox2d) {
+SimulationOptions quietOptions(const common::Pose2& start, LaserCasterKind caster = LaserCasterKind::kBox2d) {
   SimulationOptions options;
   options.start_pose = start;
   options.laser.caster = caster;
@@ -46,7 +46,7 @@ void drive(Simulation* simulation, double linear, double angular, double seconds
 }
 
 TEST(SimulationWorld, EnvironmentWallsMergedAndDoorsOpenable) {
-  const Environment environment = corridorWorld();
+  const world::Environment environment = corridorWorld();
   const SimulationWorld world = worldFromEnvironment(environment, {0});
   ASSERT_EQ(world.doors.size(), 2u);
   EXPECT_TRUE(world.doors[0].closed);
@@ -56,21 +56,22 @@ TEST(SimulationWorld, EnvironmentWallsMergedAndDoorsOpenable) {
   EXPECT_EQ(world.findDoor("1"), 0);
   EXPECT_EQ(world.findDoor("3"), -1);
   // 20 wall segments (shared walls drawn twice) merge into far fewer fixtures.
-  const WallGeometry raw = wallGeometry(environment, {0, 1});
+  const world::WallGeometry raw = world::wallGeometry(environment, {0, 1});
   EXPECT_LT(world.walls.size(), raw.walls.size());
   EXPECT_LE(world.walls.size(), 12u);
 }
 
 TEST(SimulationWorld, GridWorldBoxesCoverExactlyTheOccupiedCells) {
-  const RenderedEnvironment rendered = renderEnvironment(corridorWorld(), {0, 1});
+  const world::RenderedEnvironment rendered = world::renderEnvironment(corridorWorld(), {0, 1});
   const SimulationWorld world = worldFromGrid(rendered.map);
   double box_area = 0.0;
-  for (const Polygon& box : world.walls) box_area += area(box);
+  for (const common::Polygon& box : world.walls) box_area += common::area(box);
   const double cell_area = rendered.map.resolution * rendered.map.resolution;
-  EXPECT_NEAR(box_area / cell_area, cv::countNonZero(rendered.map.cells == OccupancyGrid::kOccupied), 1e-3);
-  EXPECT_LT(world.walls.size() * 20, static_cast<size_t>(cv::countNonZero(rendered.map.cells == OccupancyGrid::kOccupied)));
-  OccupancyGrid empty;
-  EXPECT_THROW(worldFromGrid(empty), InputError);
+  EXPECT_NEAR(box_area / cell_area, cv::countNonZero(rendered.map.cells == common::OccupancyGrid::kOccupied), 1e-3);
+  EXPECT_LT(world.walls.size() * 20,
+            static_cast<size_t>(cv::countNonZero(rendered.map.cells == common::OccupancyGrid::kOccupied)));
+  common::OccupancyGrid empty;
+  EXPECT_THROW(worldFromGrid(empty), common::InputError);
 }
 
 class CasterTest : public ::testing::TestWithParam<LaserCasterKind> {};
@@ -114,7 +115,8 @@ TEST(Simulation, NothingInRangeGivesMaxRange) {
 }
 
 TEST(Simulation, CastersAgreeOnAShippedWorld) {
-  const Environment environment = loadEnvironment(std::string(HIDDEN_ROOMS_SOURCE_DIR) + "/worlds/large_1.xml");
+  const world::Environment environment =
+      world::loadEnvironment(std::string(HIDDEN_ROOMS_SOURCE_DIR) + "/worlds/large_1.xml");
   Simulation simulation(worldFromEnvironment(environment, {}), SimulationOptions{});
   // Poses along a drive through the world; compare every beam.
   CasterAgreement agreement;
@@ -171,7 +173,7 @@ TEST(Simulation, SameSeedSameRunOtherSeedOtherNoise) {
   auto run = [](uint64_t seed, std::vector<float>* ranges) {
     SimulationOptions options;
     options.seed = seed;
-    options.start_pose = Pose2{5.0, 5.0, 0.0};
+    options.start_pose = common::Pose2{5.0, 5.0, 0.0};
     Simulation simulation(worldFromEnvironment(corridorWorld(), {}), options);
     for (int k = 0; k < 300; ++k) {
       simulation.setCommand({0.4, std::sin(k * 0.05)});
@@ -181,7 +183,7 @@ TEST(Simulation, SameSeedSameRunOtherSeedOtherNoise) {
     return simulation.odometryPose();
   };
   std::vector<float> a, b, c;
-  const Pose2 pa = run(7, &a), pb = run(7, &b), pc = run(8, &c);
+  const common::Pose2 pa = run(7, &a), pb = run(7, &b), pc = run(8, &c);
   EXPECT_EQ(a, b);
   EXPECT_EQ(pa.x, pb.x);
   EXPECT_EQ(pa.yaw, pb.yaw);
@@ -198,25 +200,25 @@ TEST(Simulation, DefaultStartPoseIsInTheCorridor) {
 TEST(Simulation, BadInputGivesClearErrors) {
   const SimulationWorld world = worldFromEnvironment(corridorWorld(), {});
   Simulation simulation(world, quietOptions({5.0, 5.0, 0.0}));
-  EXPECT_THROW(simulation.setCommand({std::numeric_limits<double>::quiet_NaN(), 0.0}), InputError);
-  EXPECT_THROW(simulation.setCommand({0.0, std::numeric_limits<double>::infinity()}), InputError);
-  EXPECT_THROW(simulation.setDoor("no_such_door", true), InputError);
-  EXPECT_THROW(simulation.setDoor("9", true), InputError);
+  EXPECT_THROW(simulation.setCommand({std::numeric_limits<double>::quiet_NaN(), 0.0}), common::InputError);
+  EXPECT_THROW(simulation.setCommand({0.0, std::numeric_limits<double>::infinity()}), common::InputError);
+  EXPECT_THROW(simulation.setDoor("no_such_door", true), common::InputError);
+  EXPECT_THROW(simulation.setDoor("9", true), common::InputError);
   SimulationOptions bad = quietOptions({5.0, 5.0, 0.0});
   bad.physics_step = 0.0;
-  EXPECT_THROW(Simulation(world, bad), InputError);
+  EXPECT_THROW(Simulation(world, bad), common::InputError);
   bad = quietOptions({5.0, 5.0, 0.0});
   bad.laser.beams = 0;
-  EXPECT_THROW(Simulation(world, bad), InputError);
+  EXPECT_THROW(Simulation(world, bad), common::InputError);
   bad = quietOptions({5.0, 5.0, 0.0});
   bad.laser.range_noise = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_THROW(Simulation(world, bad), InputError);
-  EXPECT_THROW(Simulation(world, quietOptions({4.0, 4.0, 0.0})), InputError);  // start pose on a wall
-  EXPECT_THROW(laserCasterFromString("bresenham"), InputError);
-  EXPECT_THROW(worldFromEnvironment(corridorWorld(), {5}), InputError);
-  EXPECT_THROW(loadEnvironment("/nonexistent/world.xml"), InputError);
-  EXPECT_THROW(parseEnvironment("<building><floor>", "broken.xml"), InputError);
+  EXPECT_THROW(Simulation(world, bad), common::InputError);
+  EXPECT_THROW(Simulation(world, quietOptions({4.0, 4.0, 0.0})), common::InputError);  // start pose on a wall
+  EXPECT_THROW(laserCasterFromString("bresenham"), common::InputError);
+  EXPECT_THROW(worldFromEnvironment(corridorWorld(), {5}), common::InputError);
+  EXPECT_THROW(world::loadEnvironment("/nonexistent/world.xml"), common::InputError);
+  EXPECT_THROW(world::parseEnvironment("<building><floor>", "broken.xml"), common::InputError);
 }
 
 }  // namespace
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::simulation

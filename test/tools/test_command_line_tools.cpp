@@ -34,7 +34,7 @@ TEST(RenderEnvironmentTool, WritesMapLabelsDoorsAndPreview) {
   const auto result = runCommand(kRender + " " + world + " --out " + dir + "/out --closed 2 --resolution 0.1");
   ASSERT_EQ(result.exit_code, 0) << result.output;
   EXPECT_NE(result.output.find("3 spaces, 2 doors (2 closable), 1 closed"), std::string::npos) << result.output;
-  const OccupancyGrid map = loadMap(dir + "/out/map.yaml");
+  const common::OccupancyGrid map = common::loadMap(dir + "/out/map.yaml");
   EXPECT_DOUBLE_EQ(map.resolution, 0.1);
   EXPECT_EQ(map.width(), 120);
   const cv::Mat labels = cv::imread(dir + "/out/spaces.png", cv::IMREAD_UNCHANGED);
@@ -42,7 +42,7 @@ TEST(RenderEnvironmentTool, WritesMapLabelsDoorsAndPreview) {
   double max_label = 0;
   cv::minMaxLoc(labels, nullptr, &max_label);
   EXPECT_EQ(max_label, 3.0);
-  const DoorsFile doors = loadDoors(dir + "/out/doors.yaml");
+  const common::DoorsFile doors = common::loadDoors(dir + "/out/doors.yaml");
   ASSERT_EQ(doors.doors.size(), 1u);
   EXPECT_EQ(doors.doors[0].id, 2);
   EXPECT_FALSE(cv::imread(dir + "/out/preview.png").empty());
@@ -56,7 +56,7 @@ TEST(RenderEnvironmentTool, RendersASharedEnvironmentWithAllDoorsClosed) {
   const auto result = runCommand(kRender + " " + testing::sharedDir() +
                                  "/data/environments/school/Sabadell1.xml --out " + dir + " --closed all");
   ASSERT_EQ(result.exit_code, 0) << result.output;
-  EXPECT_EQ(loadDoors(dir + "/doors.yaml").doors.size(), 17u);
+  EXPECT_EQ(common::loadDoors(dir + "/doors.yaml").doors.size(), 17u);
   // Hiding the rooms needs closable doors: Sabadell1 has 12 of its 17.
   expectBadInput(kRender + " " + testing::sharedDir() + "/data/environments/school/Sabadell1.xml --out " + dir +
                        "/hidden --closed all --hide-closed-rooms",
@@ -69,7 +69,7 @@ TEST(RenderEnvironmentTool, RendersASharedEnvironmentWithAllDoorsClosed) {
   double max_label = 0;
   cv::minMaxLoc(truth, nullptr, &max_label);
   EXPECT_EQ(max_label, 12.0);
-  EXPECT_EQ(loadDoors(dir + "/hidden/doors.yaml").doors.size(), 12u);
+  EXPECT_EQ(common::loadDoors(dir + "/hidden/doors.yaml").doors.size(), 12u);
 }
 
 // Each bad input: exit code 2 and a message naming the input and the problem.
@@ -103,13 +103,13 @@ TEST(GenerateWorldTool, BadInputGivesAClearErrorAndExitCode2) {
 
 // The synthetic hidden-room case written as files: DIR/case/map.yaml, DIR/case/doors.yaml, DIR/case/truth.png.
 std::string syntheticCase(const std::string& dir) {
-  OccupancyGrid map;
-  DoorsFile doors;
+  common::OccupancyGrid map;
+  common::DoorsFile doors;
   cv::Mat1w truth;
   testing::syntheticHiddenRoomA(&map, &doors, &truth);
   std::filesystem::create_directories(dir + "/case");
-  saveMap(map, dir + "/case/map");
-  saveDoors(doors, dir + "/case/doors.yaml");
+  common::saveMap(map, dir + "/case/map");
+  common::saveDoors(doors, dir + "/case/doors.yaml");
   cv::Mat1b truth8;
   truth.convertTo(truth8, CV_8U);
   cv::imwrite(dir + "/case/truth.png", truth8);
@@ -136,9 +136,9 @@ TEST(PredictRoomsOfflineTool, WritesRoomsCompletedMapAndMetrics) {
   EXPECT_TRUE(yaml["rooms"][0]["placed"].as<bool>());
   EXPECT_FALSE(yaml["rooms"][1]["placed"].as<bool>());
   EXPECT_GE(yaml["rooms"][0]["polygon"].size(), 3u);
-  const OccupancyGrid completed = loadMap(dir + "/out/map.yaml");
-  EXPECT_GT(cv::countNonZero(completed.cells == OccupancyGrid::kFree),
-            cv::countNonZero(loadMap(input + "/map.yaml").cells == OccupancyGrid::kFree));
+  const common::OccupancyGrid completed = common::loadMap(dir + "/out/map.yaml");
+  EXPECT_GT(cv::countNonZero(completed.cells == common::OccupancyGrid::kFree),
+            cv::countNonZero(common::loadMap(input + "/map.yaml").cells == common::OccupancyGrid::kFree));
   const YAML::Node metrics = YAML::LoadFile(dir + "/out/metrics.yaml");
   ASSERT_EQ(metrics["rooms"].size(), 2u);
   EXPECT_GT(metrics["rooms"][0]["iou"].as<double>(), 0.9);

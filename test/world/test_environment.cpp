@@ -8,7 +8,7 @@
 #include "hidden_rooms/world/environment.h"
 #include "test_util.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::world {
 namespace {
 
 using testing::corridorWithTwoRoomsXml;
@@ -107,13 +107,13 @@ TEST(Environment, ConvertsPixelsToMetresWithYUp) {
   ASSERT_EQ(environment.doors.size(), 2u);
   // Pixel (40, 40) with the largest pixel y = 120: x = 2 m, y = (120 - 40) * 0.05 = 4 m.
   const Door& door_a = environment.doors[environment.findDoor("door_a")];
-  EXPECT_LT((door_a.centre - Point2(2.0, 4.0)).norm(), 1e-12);
-  EXPECT_EQ(door_a.orientation, DoorOrientation::kAlongX);
+  EXPECT_LT((door_a.centre - common::Point2(2.0, 4.0)).norm(), 1e-12);
+  EXPECT_EQ(door_a.orientation, common::DoorOrientation::kAlongX);
   EXPECT_NEAR(door_a.wall_angle, 0.0, 1e-12);
   EXPECT_EQ(door_a.space_indices.size(), 2u);
   EXPECT_EQ(environment.findDoor("2"), environment.findDoor("door_b"));
   EXPECT_EQ(environment.findDoor("7"), -1);
-  EXPECT_NEAR(area(environment.spaces[0].outline), 10.0 * 2.0, 1e-9);
+  EXPECT_NEAR(common::area(environment.spaces[0].outline), 10.0 * 2.0, 1e-9);
 }
 
 TEST(Environment, FindsClosableDoorsAndTheRoomsBehindThem) {
@@ -129,7 +129,7 @@ TEST(Environment, ReadsAndWritesTheThesisDoorStatus) {
   EXPECT_EQ(closed.doors[closed.findDoor("door_b")].status, DoorStatus::kUnspecified);
   const Environment again = parseEnvironment(environmentToXml(closed), "round trip");
   EXPECT_EQ(again.doors[again.findDoor("door_a")].status, DoorStatus::kClosed);
-  EXPECT_THROW(parseEnvironment(corridorWithTwoRoomsXml("AJAR"), "synthetic"), InputError);
+  EXPECT_THROW(parseEnvironment(corridorWithTwoRoomsXml("AJAR"), "synthetic"), common::InputError);
 }
 
 TEST(Environment, SelectsDoorsByNumberIdOrAll) {
@@ -137,7 +137,7 @@ TEST(Environment, SelectsDoorsByNumberIdOrAll) {
   EXPECT_EQ(parseDoorSelection(environment, "", "x"), (std::set<int>{}));
   EXPECT_EQ(parseDoorSelection(environment, "all", "x"), (std::set<int>{0, 1}));
   EXPECT_EQ(parseDoorSelection(environment, "2, door_a", "x"), (std::set<int>{0, 1}));
-  EXPECT_THROW(parseDoorSelection(environment, "3", "x"), InputError);
+  EXPECT_THROW(parseDoorSelection(environment, "3", "x"), common::InputError);
 }
 
 // Bad input: each error names the input and the problem.
@@ -145,7 +145,7 @@ void expectError(const std::string& xml, const std::string& expected_problem) {
   try {
     parseEnvironment(xml, "bad.xml");
     FAIL() << "no error for: " << expected_problem;
-  } catch (const InputError& error) {
+  } catch (const common::InputError& error) {
     EXPECT_EQ(error.source(), "bad.xml");
     EXPECT_NE(std::string(error.what()).find(expected_problem), std::string::npos) << error.what();
   }
@@ -202,10 +202,10 @@ TEST(Environment, LoadNamesAMissingFile) {
   try {
     loadEnvironment("/nonexistent/world.xml");
     FAIL();
-  } catch (const InputError& error) {
+  } catch (const common::InputError& error) {
     EXPECT_EQ(std::string(error.what()), "/nonexistent/world.xml: cannot open environment file");
   }
 }
 
 }  // namespace
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::world

@@ -17,7 +17,7 @@
 #include "hidden_rooms/world/world_generator.h"
 #include "test_util.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::world {
 namespace {
 
 const SizeClass kAllClasses[] = {SizeClass::kSmall, SizeClass::kMedium, SizeClass::kLarge};
@@ -67,7 +67,7 @@ TEST(WorldGenerator, EverySpaceIsReachableWithAllDoorsOpen) {
           if (rendered.space_labels(row, col) == corridor + 1) start = {col, row};
       ASSERT_GE(start.x, 0) << "the corridor has no free cell";
 
-      const cv::Mat1b reachable = reachableFreeCells(rendered.map, start.x, start.y);
+      const cv::Mat1b reachable = common::reachableFreeCells(rendered.map, start.x, start.y);
       std::set<int> present, reached;
       for (int row = 0; row < reachable.rows; ++row)
         for (int col = 0; col < reachable.cols; ++col) {
@@ -107,7 +107,7 @@ TEST(WorldGenerator, XmlRoundTripKeepsSpacesAndDoors) {
         EXPECT_EQ(reread.spaces[s].id, environment.spaces[s].id);
         EXPECT_EQ(reread.spaces[s].label, environment.spaces[s].label);
         EXPECT_EQ(reread.spaces[s].segments.size(), environment.spaces[s].segments.size());
-        EXPECT_NEAR(area(reread.spaces[s].outline), area(environment.spaces[s].outline), 1e-6);
+        EXPECT_NEAR(common::area(reread.spaces[s].outline), common::area(environment.spaces[s].outline), 1e-6);
       }
       for (size_t d = 0; d < environment.doors.size(); ++d) {
         EXPECT_EQ(reread.doors[d].id, environment.doors[d].id);
@@ -135,9 +135,9 @@ TEST(WorldGenerator, SpacesDoNotOverlap) {
       cv::Mat1b coverage = cv::Mat1b::zeros(rows, cols);
       double sum_of_areas = 0.0;
       for (const Space& space : environment.spaces) {
-        sum_of_areas += area(space.outline);
+        sum_of_areas += common::area(space.outline);
         std::vector<cv::Point2f> contour;
-        for (const Point2& p : space.outline)
+        for (const common::Point2& p : space.outline)
           contour.emplace_back(static_cast<float>((p.x() - low.x()) / kCell), static_cast<float>((p.y() - low.y()) / kCell));
         cv::Rect box = cv::boundingRect(contour) & cv::Rect(0, 0, cols, rows);
         for (int row = box.y; row < box.y + box.height; ++row)
@@ -174,7 +174,7 @@ TEST(WorldGenerator, RoomsAndDoorsHaveSensibleGeometry) {
             EXPECT_TRUE(ids.insert(segment.id).second) << "duplicate id " << segment.id;
           }
         }
-        for (const Point2& p : space.outline) {
+        for (const common::Point2& p : space.outline) {
           // Integer XML pixels, all >= 0.
           EXPECT_NEAR(p.x() / 0.05, std::round(p.x() / 0.05), 1e-6);
           EXPECT_NEAR(p.y() / 0.05, std::round(p.y() / 0.05), 1e-6);
@@ -188,7 +188,7 @@ TEST(WorldGenerator, RoomsAndDoorsHaveSensibleGeometry) {
         EXPECT_EQ(door.space_indices.size(), 2u) << "door " << door.id;
         for (int s : door.space_indices) {
           if (environment.spaces[s].label == "CORRIDOR") continue;
-          for (const Point2& corner : environment.spaces[s].outline)
+          for (const common::Point2& corner : environment.spaces[s].outline)
             EXPECT_GE((corner - door.centre).norm(), 0.6 - 1e-9) << "door " << door.id << " near a corner";
         }
       }
@@ -218,7 +218,7 @@ TEST(WorldGenerator, RoomsAndDoorsHaveSensibleGeometry) {
 
 TEST(WorldGenerator, SizeClassNames) {
   for (SizeClass size_class : kAllClasses) EXPECT_EQ(parseSizeClass(toString(size_class)), size_class);
-  EXPECT_THROW(parseSizeClass(""), InputError);
+  EXPECT_THROW(parseSizeClass(""), common::InputError);
   EXPECT_NE(testing::inputErrorMessage([] { parseSizeClass("huge"); }).find("'huge'"), std::string::npos);
   EXPECT_EQ(sizeClassOf(0), SizeClass::kSmall);
   EXPECT_EQ(sizeClassOf(9), SizeClass::kSmall);
@@ -268,4 +268,4 @@ TEST(WorldGeneratorTool, RejectsBadCommandLines) {
 }
 
 }  // namespace
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::world

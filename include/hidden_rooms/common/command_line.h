@@ -5,7 +5,7 @@
 
 #include <boost/program_options.hpp>
 
-namespace hidden_rooms {
+namespace hidden_rooms::common {
 
 // Exit codes of the package's command-line tools.
 constexpr int kExitOk = 0;
@@ -23,4 +23,4 @@ bool parseCommandLine(int argc, char** argv, const std::string& usage,
                       const boost::program_options::positional_options_description& positional,
                       boost::program_options::variables_map* values);
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::common

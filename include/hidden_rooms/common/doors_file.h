@@ -5,7 +5,7 @@
 
 #include "hidden_rooms/common/geometry.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::common {
 
 // Door orientation as in doors.yaml: kAlongX ("O") when the door line (the wall it sits in) runs along x,
 // kAlongY ("V") when it runs along y.
@@ -36,4 +36,4 @@ DoorsFile loadDoors(const std::string& path);
 DoorsFile parseDoors(const std::string& yaml_text, const std::string& source_name);
 void saveDoors(const DoorsFile& doors, const std::string& path);
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::common

@@ -8,7 +8,7 @@
 
 #include <yaml-cpp/yaml.h>
 
-namespace hidden_rooms {
+namespace hidden_rooms::common {
 
 std::string readTextFile(const std::string& path, const std::string& what);
 YAML::Node loadYamlFile(const std::string& path, const std::string& what);
@@ -24,4 +24,4 @@ void writeTextAtomically(const std::string& path, const std::string& text, const
 // Creates an output folder (and its parents); throws InputError naming it when that is impossible.
 void createOutputDirectory(const std::string& path);
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::common

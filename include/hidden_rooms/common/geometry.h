@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-namespace hidden_rooms {
+namespace hidden_rooms::common {
 
 using Point2 = Eigen::Vector2d;
 // A simple polygon as its vertex list, without repeating the first vertex at the end.
@@ -46,4 +46,4 @@ double wrapAngle(double angle);
 // The direction of a line: the angle folded into [0, pi).
 double angleModuloPi(double angle);
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::common

@@ -7,7 +7,7 @@
 
 #include <opencv2/core.hpp>
 
-namespace hidden_rooms {
+namespace hidden_rooms::common {
 
 // Reads a PNG (any bit depth, palette images as BGR; 16-bit images with alpha are reduced to 8 bits) or a
 // Netpbm PGM / PPM (P2, P3, P5, P6; maxval above 255 gives 16 bits), chosen by the file's magic bytes.
@@ -19,4 +19,4 @@ cv::Mat readImage(const std::string& path);
 // supported or the file cannot be written.
 void writeImage(const std::string& path, const cv::Mat& image);
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::common

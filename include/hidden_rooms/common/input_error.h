@@ -3,7 +3,7 @@
 #include <stdexcept>
 #include <string>
 
-namespace hidden_rooms {
+namespace hidden_rooms::common {
 
 // Thrown by every reader and validator of the core library when its input is unusable. The message always
 // names the offending file (or "<input>" when there is none) and the problem: "FILE: problem".
@@ -23,4 +23,4 @@ class InputError : public std::runtime_error {
 // A number as messages and files show it (printf's %.10g: integers stay integers, "inf" for infinity).
 std::string formatNumber(double value);
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::common

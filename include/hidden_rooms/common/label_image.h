@@ -6,7 +6,7 @@
 
 #include <opencv2/core.hpp>
 
-namespace hidden_rooms {
+namespace hidden_rooms::common {
 
 // Writes a label image as PNG: 8-bit when every label fits, else 16-bit. Throws InputError on failure.
 void saveLabelImage(const cv::Mat1w& labels, const std::string& path);
@@ -15,4 +15,4 @@ void saveLabelImage(const cv::Mat1w& labels, const std::string& path);
 // golden angle, so that neighbouring labels differ.
 cv::Vec3b roomColour(int label);
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::common

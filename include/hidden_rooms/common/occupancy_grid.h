@@ -7,7 +7,7 @@
 
 #include "hidden_rooms/common/geometry.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::common {
 
 // An occupancy grid with nav_msgs/OccupancyGrid cell values (-1 unknown, 0 free .. 100 occupied), stored in
 // image order: row 0 is the top row (largest y), as in the map image file. `origin` is the map-frame position
@@ -66,4 +66,4 @@ std::string saveMap(const OccupancyGrid& grid, const std::string& prefix);
 // zero when (col, row) is outside the grid or not free.
 cv::Mat1b reachableFreeCells(const OccupancyGrid& grid, int col, int row);
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::common

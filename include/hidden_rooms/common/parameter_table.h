@@ -11,7 +11,7 @@
 
 #include "hidden_rooms/common/input_error.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::common {
 
 template <typename Options>
 struct ParameterField {
@@ -65,4 +65,4 @@ struct ParameterRange {
 // `value` is outside `range`.
 void requireParameterInRange(const std::string& name, double value, const ParameterRange& range);
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::common

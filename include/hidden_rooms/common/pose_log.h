@@ -5,7 +5,7 @@
 
 #include "hidden_rooms/common/geometry.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::common {
 
 // One logged pose: time (seconds, the ROS clock of the run) and the planar pose in the log's frame.
 struct TimedPose {
@@ -43,4 +43,4 @@ Pose2 poseAt(const std::vector<TimedPose>& poses, double time);
 // Length of the path through the logged positions, metres.
 double pathLength(const std::vector<TimedPose>& poses);
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::common

@@ -4,7 +4,7 @@
 
 #include "hidden_rooms/common/geometry.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::common {
 
 // The beams of a 2D laser in its own frame: beam k points at angle_min + k * angle_increment.
 struct LaserGeometry {
@@ -28,4 +28,4 @@ struct RangeScan {
   bool valid(size_t k) const { return ranges[k] > range_min && ranges[k] < range_max; }
 };
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::common

@@ -1,6 +1,6 @@
 #pragma once
 
-namespace hidden_rooms {
+namespace hidden_rooms::common {
 
 // A velocity command for a differential-drive base (geometry_msgs/Twist's linear.x and angular.z).
 struct VelocityCommand {
@@ -8,4 +8,4 @@ struct VelocityCommand {
   double angular = 0.0;  // rad/s
 };
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::common

@@ -11,12 +11,12 @@
 #include "hidden_rooms/world/environment.h"
 #include "hidden_rooms/world/render.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::evaluation {
 
 // The input of one case: what a robot maps with the doors closed, the doors file and the true rooms.
 struct BatchCase {
   std::vector<int> closed_door_numbers;  // as given (closing order), 1-based door numbers
-  HiddenRoomsCase input;                 // map with the rooms erased, doors (environment order), true rooms
+  world::HiddenRoomsCase input;          // map with the rooms erased, doors (environment order), true rooms
   double hidden_percent = 0.0;           // 100 * true room cells / free cells of the complete map
   double seconds = 0.0;                  // time to build the case
 };
@@ -24,8 +24,8 @@ struct BatchCase {
 // Renders the environment with the doors `closed_door_numbers` (1-based numbers, as in doors.yaml) closed and
 // hides the rooms behind them (renderEnvironment + hideClosedRooms). Throws InputError for a door number that
 // does not exist, a repeated one, or a door that is not closable.
-BatchCase makeBatchCase(const Environment& environment, const std::vector<int>& closed_door_numbers,
-                        const RenderOptions& options = RenderOptions());
+BatchCase makeBatchCase(const world::Environment& environment, const std::vector<int>& closed_door_numbers,
+                        const world::RenderOptions& options = world::RenderOptions());
 
 // The same from a complete map that is not the rendering (e.g. a map built by exploration): `doors_in_map`
 // gives the position of every door of the environment in the map's frame, by door number (at least the closed
@@ -33,8 +33,8 @@ BatchCase makeBatchCase(const Environment& environment, const std::vector<int>& 
 // transform of the door centres; each closed room's outline, grown by `wall_margin` metres, is erased to
 // unknown (its true room: the map's free cells inside the outline, before erasing), and each closed door is
 // painted as a wall across its width. Throws InputError when the doors are missing or do not fit.
-BatchCase makeBatchCaseFromMap(const Environment& environment, const OccupancyGrid& complete_map,
-                               const DoorsFile& doors_in_map, const std::vector<int>& closed_door_numbers,
+BatchCase makeBatchCaseFromMap(const world::Environment& environment, const common::OccupancyGrid& complete_map,
+                               const common::DoorsFile& doors_in_map, const std::vector<int>& closed_door_numbers,
                                double door_width = 0.9, double wall_margin = 0.15);
 
 // One method on one case.
@@ -48,7 +48,7 @@ struct MethodOutcome {
 
 // Runs `method` on the case and scores it (roomLabels + scoreRooms). An InputError or other exception of the
 // method is caught and reported in `problem` with zero scores.
-MethodOutcome runMethodOnCase(const RoomPredictor& method, const BatchCase& batch_case,
+MethodOutcome runMethodOnCase(const prediction::RoomPredictor& method, const BatchCase& batch_case,
                               const std::map<std::string, double>& parameters = {});
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::evaluation

@@ -11,12 +11,12 @@
 #include "hidden_rooms/world/environment.h"
 #include "hidden_rooms/world/render.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::evaluation {
 
 // Where a door of the world lies in the map a robot built (docs/method.md#closed-doors-in-the-map). `truth` is the
 // robot's true trajectory (world frame), `estimate` its SLAM trajectory (map frame), both timed on the same clock.
 struct DoorInMap {
-  Point2 position = Point2::Zero();  // map frame, metres
+  common::Point2 position = common::Point2::Zero();  // map frame, metres
   double wall_angle = 0.0;           // direction of the door's wall in the map frame, radians in [0, pi)
   double time = 0.0;                 // when the robot was closest to the door
   double robot_distance = 0.0;       // that closest distance, metres
@@ -26,34 +26,37 @@ struct DoorInMap {
 // trajectories and the door is carried over in the robot's frame, M_d = M_r(t_min) * GT_r(t_min)^-1 * GT_d, so a
 // map frame rotated against the world (the map starts at the robot's first pose) is handled; with equal headings
 // this is the thesis's M_r(t_min) + (GT_d - GT_r(t_min)). Both trajectories must not be empty.
-DoorInMap translateDoor(const Point2& door_world, double wall_angle_world, const std::vector<TimedPose>& truth,
-                        const std::vector<TimedPose>& estimate);
+DoorInMap translateDoor(const common::Point2& door_world, double wall_angle_world,
+                        const std::vector<common::TimedPose>& truth, const std::vector<common::TimedPose>& estimate);
 
 // The given doors of `environment` (indices) as a doors.yaml in the map frame: id = the door's number, width
 // `door_width`, orientation from the translated wall direction (O when it runs closer to x than to y).
-DoorsFile translateDoors(const Environment& environment, const std::vector<int>& door_indices,
-                         const std::vector<TimedPose>& truth, const std::vector<TimedPose>& estimate,
-                         double door_width);
+common::DoorsFile translateDoors(const world::Environment& environment, const std::vector<int>& door_indices,
+                                 const std::vector<common::TimedPose>& truth,
+                                 const std::vector<common::TimedPose>& estimate, double door_width);
 
 // The rigid transform world <- map that best overlays the estimated positions on the true ones at the same
 // times (least squares over the estimate's poses, Umeyama without scale). Used to score a map against its
 // world, never by the prediction. Throws InputError when fewer than two poses overlap in time or they do not
 // span any distance.
-Pose2 fitWorldFromMap(const std::vector<TimedPose>& truth, const std::vector<TimedPose>& estimate);
+common::Pose2 fitWorldFromMap(const std::vector<common::TimedPose>& truth,
+                              const std::vector<common::TimedPose>& estimate);
 
 // The same fit over the poses whose true position lies within `radius` of `centre` (world frame): where the map
 // shows a place, free of the drift a long run accumulates elsewhere. The whole run when too few poses (< 20) are
 // near.
-Pose2 fitWorldFromMapNear(const std::vector<TimedPose>& truth, const std::vector<TimedPose>& estimate,
-                          const Point2& centre, double radius);
+common::Pose2 fitWorldFromMapNear(const std::vector<common::TimedPose>& truth,
+                                  const std::vector<common::TimedPose>& estimate, const common::Point2& centre,
+                                  double radius);
 
 // The world's ground truth moved into the grid of `map`: `labels` (map's size) holds 1 + space index on the
 // free cells of each space (nearest cell of `rendered` after the transform), 0 elsewhere.
-cv::Mat1w spaceLabelsInMap(const RenderedEnvironment& rendered, const OccupancyGrid& map, const Pose2& world_from_map);
+cv::Mat1w spaceLabelsInMap(const world::RenderedEnvironment& rendered, const common::OccupancyGrid& map,
+                           const common::Pose2& world_from_map);
 
 // Label image of the rooms behind `door_indices` in the map's grid (k = room behind the k-th door, 1-based), as
 // predict_rooms_offline --gt-rooms reads it. Throws InputError for a door that is not closable.
-cv::Mat1w trueRoomsInMap(const Environment& environment, const std::vector<int>& door_indices,
+cv::Mat1w trueRoomsInMap(const world::Environment& environment, const std::vector<int>& door_indices,
                          const cv::Mat1w& space_labels_in_map);
 
 // Free cells of `rendered` a robot starting at `start` (world frame) can reach. With `clearance` 0 every free cell
@@ -62,6 +65,6 @@ cv::Mat1w trueRoomsInMap(const Environment& environment, const std::vector<int>&
 // from every non-free cell and is connected to the start through such positions (a room behind a gap narrower
 // than the robot is not reachable). Throws InputError when `start` is outside the grid or not near free space
 // (with a clearance: no centre position within 1 m of it).
-cv::Mat1b reachableFreeArea(const OccupancyGrid& rendered, const Point2& start, double clearance = 0.0);
+cv::Mat1b reachableFreeArea(const common::OccupancyGrid& rendered, const common::Point2& start, double clearance = 0.0);
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::evaluation

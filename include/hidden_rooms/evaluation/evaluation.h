@@ -4,7 +4,7 @@
 
 #include <opencv2/core.hpp>
 
-namespace hidden_rooms {
+namespace hidden_rooms::evaluation {
 
 // Scores of a prediction against the truth, docs/method.md#evaluation. Label images hold k on the cells of the room
 // behind the k-th door (1-based) and 0 elsewhere (8- or 16-bit).
@@ -17,4 +17,4 @@ struct RoomScores {
 // Throws InputError when the images differ in size or are not single-channel integer images.
 RoomScores scoreRooms(const cv::Mat& predicted_labels, const cv::Mat& true_labels, int door_count);
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::evaluation

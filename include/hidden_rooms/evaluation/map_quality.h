@@ -7,12 +7,13 @@
 #include "hidden_rooms/common/occupancy_grid.h"
 #include "hidden_rooms/common/range_scan.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::evaluation {
 
 // Cells of `truth`'s grid that a laser saw: every cell a beam crosses from `laser_pose` (world frame) up to its
 // return (or up to range_max for beams without one) is set to 255 in `observed` (CV_8U, truth's size; allocated
 // and zeroed when empty). Used to score a map only where the robot could have mapped.
-void markObservedCells(const OccupancyGrid& truth, const Pose2& laser_pose, const RangeScan& scan, cv::Mat1b* observed);
+void markObservedCells(const common::OccupancyGrid& truth, const common::Pose2& laser_pose,
+                       const common::RangeScan& scan, cv::Mat1b* observed);
 
 struct MapQuality {
   // Free-space IoU: cells free in the map (<= 19 after the rigid transform, nearest cell) against cells free in
@@ -30,14 +31,14 @@ struct MapQuality {
 
 // Scores `map` against the rendered ground truth `truth`, with `world_from_map` placing the map frame in the
 // truth's (world) frame. `observed` (truth's size, non-zero = seen) restricts the true free cells; empty = all.
-MapQuality evaluateMap(const OccupancyGrid& map, const Pose2& world_from_map, const OccupancyGrid& truth,
-                       const cv::Mat1b& observed);
+MapQuality evaluateMap(const common::OccupancyGrid& map, const common::Pose2& world_from_map,
+                       const common::OccupancyGrid& truth, const cv::Mat1b& observed);
 
 // The comparison of evaluateMap as a picture on truth's grid (BGR): true walls black, true free cells that were
 // observed and mapped free white; observed true free cells the map misses: orange where it is unknown, red where
 // it is uncertain (between free and occupied), magenta where it has a wall; map-free cells where the truth is not observed-free blue, other cells grey.
-cv::Mat3b drawMapComparison(const OccupancyGrid& map, const Pose2& world_from_map, const OccupancyGrid& truth,
-                            const cv::Mat1b& observed);
+cv::Mat3b drawMapComparison(const common::OccupancyGrid& map, const common::Pose2& world_from_map,
+                            const common::OccupancyGrid& truth, const cv::Mat1b& observed);
 
 struct TrajectoryError {
   int poses = 0;
@@ -48,7 +49,7 @@ struct TrajectoryError {
 
 // Error of `estimate` (map frame) against `truth` (world frame, same length and times) after placing the
 // estimate with `world_from_map`.
-TrajectoryError trajectoryError(const std::vector<Pose2>& estimate, const std::vector<Pose2>& truth,
-                                const Pose2& world_from_map);
+TrajectoryError trajectoryError(const std::vector<common::Pose2>& estimate, const std::vector<common::Pose2>& truth,
+                                const common::Pose2& world_from_map);
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::evaluation

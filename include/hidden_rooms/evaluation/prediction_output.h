@@ -16,7 +16,7 @@
 #include "hidden_rooms/evaluation/evaluation.h"
 #include "hidden_rooms/prediction/room_predictor.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::evaluation {
 
 struct PredictionOutputs {
   cv::Mat1w labels;                 // what rooms.png holds
@@ -25,17 +25,17 @@ struct PredictionOutputs {
 
 // Writes the files above into `out_dir` (created). `true_labels` (same size as the map, same labels) is
 // optional. Throws InputError naming a file that cannot be written.
-PredictionOutputs writePredictionOutputs(const PredictionRequest& request, const PredictionResult& result,
-                                         const std::string& method, const std::string& out_dir,
-                                         const cv::Mat& true_labels = cv::Mat());
+PredictionOutputs writePredictionOutputs(const prediction::PredictionRequest& request,
+                                         const prediction::PredictionResult& result, const std::string& method,
+                                         const std::string& out_dir, const cv::Mat& true_labels = cv::Mat());
 
 // Reads a true rooms label image and checks it has the map's size; throws InputError naming the file.
-cv::Mat loadTrueRooms(const std::string& path, const OccupancyGrid& map);
+cv::Mat loadTrueRooms(const std::string& path, const common::OccupancyGrid& map);
 
 // The summary the tools print: "METHOD: N doors in S s -> DIR", the doors not placed and, with scores, the
 // IoU per door and the means.
-void printPredictionSummary(std::ostream& out, const PredictionRequest& request, const PredictionResult& result,
-                            const std::string& method, const std::string& out_dir,
-                            const PredictionOutputs& outputs);
+void printPredictionSummary(std::ostream& out, const prediction::PredictionRequest& request,
+                            const prediction::PredictionResult& result, const std::string& method,
+                            const std::string& out_dir, const PredictionOutputs& outputs);
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::evaluation

@@ -12,7 +12,7 @@
 #include "hidden_rooms/exploration/grid_planner.h"
 #include "hidden_rooms/exploration/path_follower.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::exploration {
 
 // What the exploration policy needs (the explorer node's parameters of the same names; docs/ros_api.md).
 struct ExplorationPolicyOptions {
@@ -50,7 +50,8 @@ enum class ExplorationEventType {
 
 struct ExplorationEvent {
   ExplorationEventType type = ExplorationEventType::kNoGoal;
-  Point2 position = Point2::Zero();  // the goal's (goal events) or the robot's (passages, kStartBlocked)
+  common::Point2 position =
+      common::Point2::Zero();        // the goal's (goal events) or the robot's (passages, kStartBlocked)
   size_t count = 0;                  // places or points released; frontiers (kNoGoal)
   size_t blacklisted = 0;            // blacklisted places (kNoGoal, kDone)
   int recoveries = 0;                // of the failed goal
@@ -62,7 +63,7 @@ struct ExplorationEvent {
 
 // One control step's outcome.
 struct ExplorationStep {
-  VelocityCommand command;
+  common::VelocityCommand command;
   bool planned = false;  // a plan computed frontiers (frontiers(), goal(), the path and the blacklist are new)
   std::vector<ExplorationEvent> events;
 };
@@ -80,16 +81,16 @@ class ExplorationPolicy {
   explicit ExplorationPolicy(const ExplorationPolicyOptions& options = ExplorationPolicyOptions());
 
   // A new map (map frame): the next step plans with it.
-  void setMap(const OccupancyGrid& map);
+  void setMap(const common::OccupancyGrid& map);
   // A new map that could not be read (`reason`): the next step's plan reports it (kMapUnusable) and keeps the
   // old map.
   void setUnusableMap(const std::string& reason);
   // The returns (base_link) of a new scan, with the robot at `pose` (map frame) at `time`.
-  void addScan(const std::vector<Point2>& points, const Pose2& pose, double time);
+  void addScan(const std::vector<common::Point2>& points, const common::Pose2& pose, double time);
   // The robot is held still from outside at `time` (map, pose or scan stale); see PathFollower::hold.
   void hold(double time);
   // The command for the robot at `pose` (map frame) at `time`, planning when due.
-  ExplorationStep update(const Pose2& pose, double time);
+  ExplorationStep update(const common::Pose2& pose, double time);
 
   bool done() const { return done_; }
   const std::optional<FrontierGoal>& goal() const { return goal_; }
@@ -104,9 +105,9 @@ class ExplorationPolicy {
  private:
   enum class PendingMap { kNone, kUsable, kUnusable };
   // Chooses a goal and a path from `pose`, releasing blocked goals when none is left; counts towards done.
-  void plan(const Pose2& pose, double time, ExplorationStep* step);
+  void plan(const common::Pose2& pose, double time, ExplorationStep* step);
   // Blacklists the goal that just ended (reached or failed) and records failed passages.
-  void finishGoal(const Pose2& pose, FollowerState outcome, ExplorationStep* step);
+  void finishGoal(const common::Pose2& pose, FollowerState outcome, ExplorationStep* step);
 
   ExplorationPolicyOptions options_;
   GridPlanner planner_;
@@ -115,7 +116,7 @@ class ExplorationPolicy {
   BlockedPassages passages_;
   ObstacleMemory obstacle_memory_;
   PendingMap pending_map_ = PendingMap::kNone;
-  OccupancyGrid next_map_;
+  common::OccupancyGrid next_map_;
   std::string unusable_reason_;
   FrontierMap frontiers_;
   std::optional<FrontierGoal> goal_;
@@ -124,4 +125,4 @@ class ExplorationPolicy {
   bool done_ = false;
 };
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::exploration

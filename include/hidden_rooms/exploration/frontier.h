@@ -10,7 +10,7 @@
 #include "hidden_rooms/common/occupancy_grid.h"
 #include "hidden_rooms/exploration/grid_planner.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::exploration {
 
 struct FrontierOptions {
   int free_threshold = 19;       // cells with 0 <= value <= this are free ...
@@ -25,7 +25,7 @@ struct FrontierOptions {
 struct Frontier {
   int label = 0;                 // 1-based, its value in FrontierMap::labels
   std::vector<cv::Point> cells;  // (col, row) in the map's image order
-  Point2 centroid = Point2::Zero();  // map frame, metres
+  common::Point2 centroid = common::Point2::Zero();  // map frame, metres
 };
 
 struct FrontierMap {
@@ -36,7 +36,7 @@ struct FrontierMap {
 // Frontier cells are free cells with a 4-neighbour that is unknown (-1, or neither free nor occupied, or outside
 // the grid) and belongs to an unknown area of at least min_unknown_cells; they are grouped 8-connected (OpenCV connected components) and
 // groups under min_frontier_cells dropped. An empty map has none.
-FrontierMap findFrontiers(const OccupancyGrid& map, const FrontierOptions& options = FrontierOptions());
+FrontierMap findFrontiers(const common::OccupancyGrid& map, const FrontierOptions& options = FrontierOptions());
 
 // How a goal ended, for the blacklist.
 enum class GoalOutcome {
@@ -49,19 +49,19 @@ enum class GoalOutcome {
 // Failed places get one more try when nothing else is left: a failure can have a passing cause (a mapping glitch,
 // a late control loop), and a blacklisted doorway hides everything behind it.
 struct Blacklist {
-  std::vector<Point2> points;
+  std::vector<common::Point2> points;
   double radius = 0.8;  // metres
   // Of `points`, the goals that failed while the robot could not move at all: the robot was stuck, the place may
   // be fine.
-  std::vector<Point2> stuck_points;
+  std::vector<common::Point2> stuck_points;
   // Of `points`, the goals that failed while the robot moved and are not within `radius` of a place that already
   // had its second try.
-  std::vector<Point2> failed_points;
+  std::vector<common::Point2> failed_points;
   // Places released by releaseFailed(); failures near them stay blacklisted.
-  std::vector<Point2> retried_points;
-  bool contains(const Point2& point) const;
+  std::vector<common::Point2> retried_points;
+  bool contains(const common::Point2& point) const;
   // Lists the place; true when it is kept for a later release (robot stuck, or a first failure there).
-  bool add(const Point2& point, GoalOutcome outcome);
+  bool add(const common::Point2& point, GoalOutcome outcome);
   // Takes the stuck places off the list, so that they are tried again; returns how many there were.
   size_t releaseStuck();
   // Takes failed_points off the list for their second try (they become retried_points); returns how many.
@@ -91,9 +91,9 @@ class BlockedPassages {
   explicit BlockedPassages(const BlockedPassagesOptions& options = BlockedPassagesOptions());
   // A goal failed with the robot at `robot` following `path` (map frame, from where it started). True when
   // blockedPoints() changed.
-  bool addFailure(const Point2& robot, const std::vector<Point2>& path);
+  bool addFailure(const common::Point2& robot, const std::vector<common::Point2>& path);
   // Points whose disc of options().radius the planner must not cross.
-  const std::vector<Point2>& blockedPoints() const { return blocked_; }
+  const std::vector<common::Point2>& blockedPoints() const { return blocked_; }
   // Opens every blocked passage again, once per explorer run (when no other goal is left, in case a passage was
   // blocked by failures that had another cause); returns how many points were unblocked (0 after the first time).
   size_t releaseOnce();
@@ -101,23 +101,23 @@ class BlockedPassages {
 
  private:
   struct Failure {
-    Point2 robot;
-    Point2 direction;  // unit vector from the robot to the stretch's end
-    std::vector<Point2> stretch;
+    common::Point2 robot;
+    common::Point2 direction;  // unit vector from the robot to the stretch's end
+    std::vector<common::Point2> stretch;
     bool blocking = false;
   };
   void collectBlocked();
   BlockedPassagesOptions options_;
   std::vector<Failure> failures_;
-  std::vector<Point2> wedged_;  // places the robot failed from in different directions
-  std::vector<Point2> blocked_;
+  std::vector<common::Point2> wedged_;  // places the robot failed from in different directions
+  std::vector<common::Point2> blocked_;
   bool released_ = false;
 };
 
 struct FrontierGoal {
   int frontier_label = 0;  // label in the FrontierMap
   cv::Point cell;          // the goal cell (traversable, reachable)
-  Point2 position = Point2::Zero();  // its centre, map frame
+  common::Point2 position = common::Point2::Zero();       // its centre, map frame
   double cost = std::numeric_limits<double>::infinity();  // the planner's path cost to it
 };
 
@@ -129,7 +129,7 @@ struct FrontierGoal {
 // when no frontier is reachable.
 std::optional<FrontierGoal> nearestFrontierGoal(const FrontierMap& frontiers, const GridPlanner& planner,
                                                 const Blacklist& blacklist, const FrontierOptions& options,
-                                                const std::optional<Point2>& previous = std::nullopt,
+                                                const std::optional<common::Point2>& previous = std::nullopt,
                                                 double hysteresis = 1.0);
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::exploration

@@ -7,7 +7,7 @@
 #include "hidden_rooms/common/geometry.h"
 #include "hidden_rooms/common/occupancy_grid.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::exploration {
 
 struct GridPlannerOptions {
   int free_threshold = 19;        // cells with 0 <= value <= this are free (map_saver's 0.196)
@@ -38,20 +38,20 @@ class GridPlanner {
   explicit GridPlanner(const GridPlannerOptions& options = GridPlannerOptions());
 
   // Builds the inflated cost map; an empty map gives a planner where nothing is reachable.
-  void setMap(const OccupancyGrid& map);
+  void setMap(const common::OccupancyGrid& map);
   // Cells within `radius` (metres) of these points (map frame) are neither traversable nor roomy, in this map and
   // the next ones, until set again (an empty list unblocks). Applies at once; the next computeCostsFrom uses it.
-  void setBlockedPoints(const std::vector<Point2>& points, double radius);
-  const OccupancyGrid& map() const { return map_; }
+  void setBlockedPoints(const std::vector<common::Point2>& points, double radius);
+  const common::OccupancyGrid& map() const { return map_; }
 
   // Costs from `start` (map frame) to every traversable cell. False (and nothing reachable) when the start lies
   // outside the map or no traversable cell is within start_escape_radius of it.
-  bool computeCostsFrom(const Point2& start);
+  bool computeCostsFrom(const common::Point2& start);
 
   // Path cost (metres weighted by proximity) from the last start to the cell; +infinity when unreachable or
   // outside the grid.
   double costTo(int col, int row) const;
-  double costTo(const Point2& point) const;
+  double costTo(const common::Point2& point) const;
   // 255 where the robot's centre may stand (free and at least min_clearance from obstacles), else 0.
   const cv::Mat1b& traversable() const { return traversable_; }
   // 255 where it stands with room to spare (traversable and at least robot_radius from obstacles), else 0.
@@ -64,11 +64,11 @@ class GridPlanner {
   // Cell-centre path (map frame) from the start to a reachable cell, smoothed with a moving average that keeps
   // every point on a traversable cell; the first point is the start cell's centre, the last the goal cell's.
   // Empty when the cell is unreachable.
-  std::vector<Point2> pathTo(int col, int row) const;
+  std::vector<common::Point2> pathTo(int col, int row) const;
 
  private:
   GridPlannerOptions options_;
-  OccupancyGrid map_;
+  common::OccupancyGrid map_;
   cv::Mat1b traversable_;
   cv::Mat1b roomy_;
   cv::Mat1f obstacle_distance_;
@@ -76,11 +76,11 @@ class GridPlanner {
   cv::Mat1d cost_;         // path cost from the start (infinity where unreachable)
   cv::Mat1i parent_;       // index (row * width + col) of the predecessor, -1 at the start / unreached
   cv::Point start_cell_{-1, -1};
-  std::vector<Point2> blocked_points_;
+  std::vector<common::Point2> blocked_points_;
   double blocked_radius_ = 0.0;
 };
 
 // Length (metres) of a polyline.
-double pathLength(const std::vector<Point2>& path);
+double pathLength(const std::vector<common::Point2>& path);
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::exploration

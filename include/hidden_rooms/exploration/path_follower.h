@@ -7,7 +7,7 @@
 #include "hidden_rooms/common/range_scan.h"
 #include "hidden_rooms/common/velocity_command.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::exploration {
 
 struct PathFollowerOptions {
   double max_linear_velocity = 0.5;    // m/s
@@ -61,14 +61,14 @@ enum class FollowerState { kIdle, kFollowing, kBackingOff, kRecoveryRotating, kG
 const char* toString(FollowerState state);
 
 struct FollowerStep {
-  VelocityCommand command;
+  common::VelocityCommand command;
   FollowerState state = FollowerState::kIdle;
   double front_clearance = 0.0;  // metres of free space ahead of the robot's front in its lane
 };
 
 // The returns of a scan as points in base_link (through scan.sensor_pose); beams without a valid return
 // (non-finite, at or below range_min, at or beyond range_max) are skipped and counted in `skipped` when given.
-std::vector<Point2> obstaclePoints(const RangeScan& scan, int* skipped = nullptr);
+std::vector<common::Point2> obstaclePoints(const common::RangeScan& scan, int* skipped = nullptr);
 
 // Laser points of the last few scans, kept in the map frame, so that what the laser no longer sees (beside and
 // behind the robot's rear, outside a 270 degree field of view) still counts for a little while.
@@ -77,15 +77,15 @@ class ObstacleMemory {
   explicit ObstacleMemory(double duration = 1.5) : duration_(duration) {}
   // Adds the points (base_link) of a scan taken with the robot at `pose` (map frame) at `time` (seconds); scans
   // older than `duration` before it are forgotten.
-  void add(const std::vector<Point2>& points, const Pose2& pose, double time);
+  void add(const std::vector<common::Point2>& points, const common::Pose2& pose, double time);
   // Every remembered point in the base_link of a robot at `pose`.
-  std::vector<Point2> points(const Pose2& pose) const;
+  std::vector<common::Point2> points(const common::Pose2& pose) const;
   void clear() { scans_.clear(); }
 
  private:
   struct Scan {
     double time = 0.0;
-    std::vector<Point2> points;  // map frame
+    std::vector<common::Point2> points;  // map frame
   };
   double duration_;
   std::vector<Scan> scans_;
@@ -94,9 +94,9 @@ class ObstacleMemory {
 // Free space (metres) ahead of the robot's front edge within its lane (footprint width plus side_margin on both
 // sides), from obstacle points in base_link; +infinity when the lane is empty. Points inside the footprint's front
 // half count as 0; points beside it (in the side margins) do not count: driving straight does not come closer.
-double frontClearance(const std::vector<Point2>& obstacles, const PathFollowerOptions& options);
+double frontClearance(const std::vector<common::Point2>& obstacles, const PathFollowerOptions& options);
 // The same behind the rear edge (the laser may not see there: then +infinity).
-double rearClearance(const std::vector<Point2>& obstacles, const PathFollowerOptions& options);
+double rearClearance(const std::vector<common::Point2>& obstacles, const PathFollowerOptions& options);
 
 // Pure pursuit along a path with a laser speed limit and a recovery state machine. Times are seconds of any
 // monotonic clock (the node uses ROS time).
@@ -105,9 +105,9 @@ class PathFollower {
   explicit PathFollower(const PathFollowerOptions& options = PathFollowerOptions());
 
   // Follows `path` (map frame) from `time` on; resets progress and recoveries. An empty path stops (kIdle).
-  void setPath(const std::vector<Point2>& path, double time);
+  void setPath(const std::vector<common::Point2>& path, double time);
   // Keeps following the new path of the same goal (a replan): progress and recovery counters stay.
-  void updatePath(const std::vector<Point2>& path);
+  void updatePath(const std::vector<common::Point2>& path);
   void stop();
   // The robot is held still from outside at `time` (the node stops it while its map, pose or scan is stale).
   // The held time, up to the next update, counts neither for the progress timeout nor for the stall watch, and a
@@ -116,47 +116,49 @@ class PathFollower {
 
   // The command for the robot at `pose` (map frame) with obstacle points (metres, base_link). kGoalReached and
   // kFailed stay (with zero commands) until the next setPath.
-  FollowerStep update(const Pose2& pose, const std::vector<Point2>& obstacles, double time);
+  FollowerStep update(const common::Pose2& pose, const std::vector<common::Point2>& obstacles, double time);
 
   FollowerState state() const { return state_; }
   int recoveries() const { return recoveries_; }
   // Recoveries since setPath after which the robot had neither moved stall_distance nor turned stall_angle
   // from where the recovery started: its commands produced no motion (the robot is pinned, or its drive is off).
   int recoveriesWithoutMotion() const { return recoveries_without_motion_; }
-  const std::vector<Point2>& path() const { return path_; }
+  const std::vector<common::Point2>& path() const { return path_; }
   const PathFollowerOptions& options() const { return options_; }
 
  private:
-  FollowerStep follow(const Pose2& pose, const std::vector<Point2>& obstacles, double clearance);
+  FollowerStep follow(const common::Pose2& pose, const std::vector<common::Point2>& obstacles, double clearance);
   // True when the footprint (plus side_margin, or 70% of the present gap when something is already closer) moving
   // forward on the
   // arc (linear > 0, angular) from base_link meets an obstacle point within arc_horizon seconds and max_distance
   // metres.
-  bool arcHitsObstacle(const std::vector<Point2>& obstacles, double linear, double angular, double max_distance) const;
+  bool arcHitsObstacle(const std::vector<common::Point2>& obstacles, double linear, double angular,
+                       double max_distance) const;
   // Laser points beside both sides of the footprint within doorway_distance.
-  bool inDoorway(const std::vector<Point2>& obstacles) const;
+  bool inDoorway(const std::vector<common::Point2>& obstacles) const;
   // Turning in place at `angular`, with laser points inside the circle the footprint sweeps (+ side_margin): on
   // the front half only, also backing away at creep_velocity (rear lane free); on the rear half only, creeping
   // forward (lane ahead free); on both halves, creeping straight ahead without turning (lane ahead free).
-  VelocityCommand turnInPlace(double angular, const std::vector<Point2>& obstacles, double front_clearance) const;
-  double remainingLength(const Pose2& pose);
+  common::VelocityCommand turnInPlace(double angular, const std::vector<common::Point2>& obstacles,
+                                      double front_clearance) const;
+  double remainingLength(const common::Pose2& pose);
   // Whether `pose` is within stall_distance and stall_angle of `since` (the robot has not moved).
-  bool withinStall(const Pose2& pose, const Pose2& since) const;
+  bool withinStall(const common::Pose2& pose, const common::Pose2& since) const;
 
   PathFollowerOptions options_;
-  std::vector<Point2> path_;
+  std::vector<common::Point2> path_;
   FollowerState state_ = FollowerState::kIdle;
   size_t closest_index_ = 0;
   // Progress: best remaining length and when it last improved by progress_distance.
   double best_remaining_ = 0.0;
   double progress_time_ = 0.0;
   // Stall watch: where and when the robot last moved.
-  Pose2 anchor_pose_;
+  common::Pose2 anchor_pose_;
   double anchor_time_ = 0.0;
   bool anchor_set_ = false;
   double recovery_until_ = 0.0;
   double recovery_turn_sign_ = 1.0;
-  Pose2 recovery_start_pose_;
+  common::Pose2 recovery_start_pose_;
   int recoveries_ = 0;
   int recoveries_without_motion_ = 0;
   // Kept across goals: whether the last recovery moved the robot (else the next one turns the other way).
@@ -166,4 +168,4 @@ class PathFollower {
   double held_since_ = 0.0;
 };
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::exploration

@@ -7,7 +7,7 @@
 
 #include "hidden_rooms/common/occupancy_grid.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::map3d {
 
 // 2D maps to and from OctoMap 3D maps (octomap::OcTree .bt, octomap::ColorOcTree .ot). OctoMap's types stay
 // inside the implementation; the frame is the map's (z up, the floor at z = 0).
@@ -22,12 +22,12 @@ struct ExtrusionOptions {
 // with label k > 0 in `room_labels`, map-sized or empty, and the walls next to them) take the room's overlay
 // colour and the rest is grey; `.bt` writes a plain OcTree (occupancy only). Throws InputError for another
 // extension, bad options, a label image of the wrong size or a file that cannot be written.
-void exportOctomap(const OccupancyGrid& map, const cv::Mat1w& room_labels, const ExtrusionOptions& options,
+void exportOctomap(const common::OccupancyGrid& map, const cv::Mat1w& room_labels, const ExtrusionOptions& options,
                    const std::string& path);
 
 // The label image of a prediction's rooms.yaml (predict_rooms_offline, predict_rooms_client) in `map`'s grid:
 // each placed room's polygon filled with its label. Throws InputError for a missing or malformed file.
-cv::Mat1w roomLabelsFromYaml(const std::string& rooms_yaml, const OccupancyGrid& map);
+cv::Mat1w roomLabelsFromYaml(const std::string& rooms_yaml, const common::OccupancyGrid& map);
 
 struct SliceOptions {
   double z_min = 0.1;       // metres: the height band projected to 2D
@@ -38,6 +38,6 @@ struct SliceOptions {
 // A height band of a 3D OctoMap (.bt or .ot) projected to a 2D map: a cell is occupied when any voxel of the
 // band above it is occupied, free when some voxel of that band is observed free and none is occupied, unknown
 // otherwise. The grid covers the tree's known extent. Throws InputError for a missing, unreadable or empty file or a bad band.
-OccupancyGrid sliceOctomap(const std::string& path, const SliceOptions& options);
+common::OccupancyGrid sliceOctomap(const std::string& path, const SliceOptions& options);
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::map3d

@@ -12,7 +12,7 @@ namespace mrpt::obs {
 class CObservation2DRangeScan;
 }
 
-namespace hidden_rooms {
+namespace hidden_rooms::mapping {
 
 struct RbpfMapperOptions {
   // MRPT ini file (config/rbpf.ini): particle filter, proposal, insertion distances, grid, likelihood model and
@@ -25,7 +25,7 @@ struct RbpfMapperOptions {
 
 // A particle of the filter: the robot pose (base_link in the map frame) and its normalised weight.
 struct RbpfParticle {
-  Pose2 pose;
+  common::Pose2 pose;
   double weight = 0.0;
 };
 
@@ -46,27 +46,27 @@ class RbpfMapper {
   // (and the map grows) only when the odometry moved beyond the ini's localize / insertion distances since the
   // last update. Returns true when the scan was inserted into the map. Throws InputError for a scan without
   // beams or with a non-finite geometry.
-  bool addScan(const Pose2& odometry, const RangeScan& scan);
+  bool addScan(const common::Pose2& odometry, const common::RangeScan& scan);
   // The same with a scan already in MRPT's form (ROS messages: hidden_rooms/ros/mrpt_scan.h, mrpt-ros1bridge);
   // its sensorPose is the laser in base_link. Throws InputError for a scan without beams.
-  bool addScan(const Pose2& odometry, const mrpt::obs::CObservation2DRangeScan& scan);
+  bool addScan(const common::Pose2& odometry, const mrpt::obs::CObservation2DRangeScan& scan);
 
   int scansAdded() const;
   int scansInserted() const;
   // The pose estimate of base_link in the map frame: the pose (with the odometry since the filter's last update)
   // of the particle whose grid map() returns, so that pose and map agree; the first odometry pose before any scan.
-  Pose2 pose() const;
+  common::Pose2 pose() const;
   // map -> odom (REP-105): the transform that puts the last odometry pose at pose().
-  Pose2 mapToOdom() const;
+  common::Pose2 mapToOdom() const;
   std::vector<RbpfParticle> particles() const;
   // The published grid in the map frame (-1 never observed, else 0..100 = occupancy probability in percent):
   // every inserted scan drawn along the path of the most likely particle with the [PublishedMap] certainties of
   // the ini. Empty before the first inserted scan.
-  OccupancyGrid map() const;
+  common::OccupancyGrid map() const;
 
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::mapping

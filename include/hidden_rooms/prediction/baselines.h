@@ -8,7 +8,7 @@
 
 #include "hidden_rooms/prediction/room_predictor.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::prediction {
 
 // "unstructured": from the unknown cell nearest the door, every unknown cell seen along a straight line
 // through unknown cells (a 360° laser from that cell), stopped by known cells and the known cells' bounding box.
@@ -29,4 +29,4 @@ class SkewNormalPredictor : public RoomPredictor {
   PredictionResult predict(const PredictionRequest& request) const override;
 };
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::prediction

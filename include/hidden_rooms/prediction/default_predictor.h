@@ -50,7 +50,7 @@
 
 #include "hidden_rooms/prediction/room_predictor.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::prediction {
 
 class DefaultPredictor : public RoomPredictor {
  public:
@@ -62,14 +62,14 @@ class DefaultPredictor : public RoomPredictor {
 
 // Dominant wall direction of a map, radians in [-pi/4, pi/4): the walls run along this angle and the one
 // perpendicular to it (image frame: x = column, y = row). 0 when the map has no occupied cells.
-double dominantWallAngle(const OccupancyGrid& map);
+double dominantWallAngle(const common::OccupancyGrid& map);
 
 // How much of the thickness of walls seen from one side a map does not show, metres: the most common length
 // (3 pixels to 1 m) of the runs along rows and columns that cross a wall seen from both sides (from a free cell,
 // starting and ending on an occupied cell, to the next free cell; the wall's inside may be unknown) less the median
 // occupied run between a free and an unknown cell (a wall seen from one side). 0 when the map draws whole walls,
 // or has fewer than 20 runs of either kind.
-double unseenWallThickness(const OccupancyGrid& map);
+double unseenWallThickness(const common::OccupancyGrid& map);
 
 // Clips a room (mask, image frame) to the known map's extent beside it: x to the known pixels of the rows within
 // `reach` pixels of the room's rows, y likewise from its columns, so that a room does not stick out of the
@@ -77,4 +77,4 @@ double unseenWallThickness(const OccupancyGrid& map);
 // pixels beyond the door pixel (otherwise nothing is known on that side).
 void clipToKnownOutline(const cv::Mat1b& known, const cv::Point& door, int reach, int min_depth, cv::Mat1b* mask);
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::prediction

@@ -19,7 +19,7 @@
 #include "hidden_rooms/common/geometry.h"
 #include "hidden_rooms/common/occupancy_grid.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::prediction {
 
 // Parameters of the analysis. config/layout.yaml documents each one (meaning, unit, the reference
 // implementation's value) and holds exactly these defaults. Lengths are metres, converted to pixels with the
@@ -62,8 +62,8 @@ void validateLayoutOptions(const LayoutOptions& options);
 
 // A straight segment in image coordinates.
 struct ImageSegment {
-  Point2 a = Point2::Zero();
-  Point2 b = Point2::Zero();
+  common::Point2 a = common::Point2::Zero();
+  common::Point2 b = common::Point2::Zero();
   double length() const { return (b - a).norm(); }
   // Direction angle modulo pi, in [0, pi).
   double angle() const;
@@ -119,7 +119,7 @@ struct CellGrid {
   // The shared edge of two edge-adjacent cells as a segment in image coordinates (false when not adjacent).
   bool sharedEdge(int a, int b, ImageSegment* edge) const;
   // The cell containing an image point, -1 outside the grid.
-  int cellAt(const Point2& image_point) const;
+  int cellAt(const common::Point2& image_point) const;
 };
 
 // Where a closed door enters the cell grid (docs/method.md#door-start-cells): the nearest edge between an IN and an
@@ -131,7 +131,8 @@ struct DoorStart {
   int start_cell = -1;             // the OUT cell behind the door: the hidden room's first cell
   int explored_cell = -1;          // the IN cell on the explored side of the edge
   ImageSegment edge;               // the shared edge, image coordinates
-  Point2 position = Point2::Zero(); // the edge's centre in the map frame (metres): the door on the grid
+  common::Point2 position =
+      common::Point2::Zero();      // the edge's centre in the map frame (metres): the door on the grid
   double distance = 0.0;           // metres from the door's given position to the edge
 };
 
@@ -153,10 +154,10 @@ struct Layout {
 // needed and receives edges.png, segments.png, angular_clusters.png, walls.png, extended_lines.png,
 // cells.png, rooms.png and start_cells.png; InputError when it cannot be written. Throws InputError for an
 // empty map or bad options.
-Layout analyzeLayout(const OccupancyGrid& map, const std::vector<MapDoor>& closed_doors,
+Layout analyzeLayout(const common::OccupancyGrid& map, const std::vector<common::MapDoor>& closed_doors,
                      const LayoutOptions& options = LayoutOptions(), const std::string& debug_dir = "");
 
 // Mask of the map's size: 255 on the pixels of the given cells (clipped to the image), 0 elsewhere.
 cv::Mat1b cellsMask(const Layout& layout, const std::vector<int>& cells);
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::prediction

@@ -11,14 +11,14 @@
 #include "hidden_rooms/common/geometry.h"
 #include "hidden_rooms/common/occupancy_grid.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::prediction {
 
 // What every prediction method gets: the explored map and its closed doors (map frame), plus optional
 // parameter overrides (`name: value` pairs from a parameters file or a service request) and an optional folder
 // for per-stage debug images (empty = none).
 struct PredictionRequest {
-  OccupancyGrid map;
-  DoorsFile doors;
+  common::OccupancyGrid map;
+  common::DoorsFile doors;
   std::map<std::string, double> parameters;
   std::string debug_dir;
 };
@@ -30,7 +30,7 @@ struct RoomPrediction {
   bool placed = false;
   std::string problem;                  // why the door could not be placed, when !placed
   cv::Mat1b mask;
-  Polygon polygon;                      // outline of the room, map frame, metres (empty when !placed)
+  common::Polygon polygon;              // outline of the room, map frame, metres (empty when !placed)
   double area = 0.0;                    // square metres of mask
   std::map<std::string, double> terms;  // the method's score terms, for reports
 };
@@ -69,4 +69,4 @@ std::vector<std::string> roomPredictorNames();
 // Throws InputError naming the method and the known ones when `name` is not registered.
 std::unique_ptr<RoomPredictor> makeRoomPredictor(const std::string& name);
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::prediction

@@ -9,7 +9,7 @@
 #include "hidden_rooms/prediction/layout.h"
 #include "hidden_rooms/prediction/room_predictor.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::prediction {
 
 // "structured": the layout analysis (layout.h) places every door on the cell grid; from the door's starting
 // cell the room floods every edge-adjacent OUT cell that is not a border cell. The room is the union of those
@@ -29,7 +29,7 @@ std::vector<int> structuredRoomCells(const Layout& layout, const DoorStart& star
 
 // A prediction made of grid cells: mask = the cells' pixels that are unknown in `map`, polygon and area from
 // the mask (placed = false with a problem when no pixel is left).
-RoomPrediction roomFromCells(const OccupancyGrid& map, const Layout& layout, int door_id,
+RoomPrediction roomFromCells(const common::OccupancyGrid& map, const Layout& layout, int door_id,
                              const std::vector<int>& cells);
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::prediction

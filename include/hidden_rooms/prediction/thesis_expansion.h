@@ -14,7 +14,7 @@
 #include "hidden_rooms/prediction/layout.h"
 #include "hidden_rooms/prediction/thesis_predictor.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::prediction {
 
 // A hidden room being grown: its door (index into Layout::doors), start cell (OUT) and explored cell (IN), its
 // cells, and what the growth reports about it.
@@ -89,4 +89,4 @@ class ThesisExpansion {
   std::vector<ThesisRoom> rooms_;
 };
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::prediction

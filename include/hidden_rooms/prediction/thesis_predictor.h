@@ -10,7 +10,7 @@
 #include "hidden_rooms/prediction/layout.h"
 #include "hidden_rooms/prediction/room_predictor.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::prediction {
 
 // The method's constants (config/prediction.yaml documents each one under its `thesis_` name).
 struct ThesisOptions {
@@ -92,4 +92,4 @@ class ThesisPredictor : public RoomPredictor {
   PredictionResult predict(const PredictionRequest& request) const override;
 };
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::prediction

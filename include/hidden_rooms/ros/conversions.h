@@ -27,20 +27,20 @@
 namespace hidden_rooms {
 
 // A map-frame point at height `z`.
-geometry_msgs::Point toRos(const Point2& point, double z);
+geometry_msgs::Point toRos(const common::Point2& point, double z);
 
 // Core grids keep row 0 at the top (image order); nav_msgs keeps row 0 at the origin (bottom).
-nav_msgs::OccupancyGrid toRos(const OccupancyGrid& grid, const std::string& frame_id, const ros::Time& stamp);
+nav_msgs::OccupancyGrid toRos(const common::OccupancyGrid& grid, const std::string& frame_id, const ros::Time& stamp);
 // Throws InputError for a message whose data size does not match width x height, a non-positive resolution
 // or a rotated origin.
-OccupancyGrid fromRos(const nav_msgs::OccupancyGrid& message);
+common::OccupancyGrid fromRos(const nav_msgs::OccupancyGrid& message);
 
-hidden_rooms::ClosedDoor toRos(const MapDoor& door);
-MapDoor fromRos(const hidden_rooms::ClosedDoor& message);
+hidden_rooms::ClosedDoor toRos(const common::MapDoor& door);
+common::MapDoor fromRos(const hidden_rooms::ClosedDoor& message);
 
 // Doors of a request, in `frame`. Throws InputError naming a bad door (non-finite, bad width or orientation).
-DoorsFile fromRos(const std::vector<hidden_rooms::ClosedDoor>& messages, const std::string& frame);
-std::vector<hidden_rooms::ClosedDoor> toRos(const DoorsFile& doors);
+common::DoorsFile fromRos(const std::vector<hidden_rooms::ClosedDoor>& messages, const std::string& frame);
+std::vector<hidden_rooms::ClosedDoor> toRos(const common::DoorsFile& doors);
 
 // Parameter overrides. Throws InputError("parameters", ...) for an empty or repeated name or a non-finite value.
 std::map<std::string, double> fromRos(const std::vector<hidden_rooms::PredictionParameter>& messages);
@@ -49,35 +49,35 @@ std::vector<hidden_rooms::PredictionParameter> toRos(const std::map<std::string,
 // The message of the room predicted for the door with 1-based position `label` in the request: status, polygon,
 // area, score ("score" term, NaN without one), terms, and the mask cropped to the room's bounding box (0 on its
 // cells, -1 elsewhere) in `map`'s cell grid.
-hidden_rooms::PredictedRoom toRos(const RoomPrediction& room, int label, const OccupancyGrid& map,
+hidden_rooms::PredictedRoom toRos(const prediction::RoomPrediction& room, int label, const common::OccupancyGrid& map,
                                   const std::string& frame_id, const ros::Time& stamp);
 // The room back with its mask at the map's size (255 on its cells). Throws InputError when the mask does not lie
 // on the map's cell grid or term names and values differ in length.
-RoomPrediction fromRos(const hidden_rooms::PredictedRoom& message, const OccupancyGrid& map);
+prediction::RoomPrediction fromRos(const hidden_rooms::PredictedRoom& message, const common::OccupancyGrid& map);
 
 // Simulator. A velocity command as it came (non-finite values pass: Simulation::setCommand rejects them).
-VelocityCommand fromRos(const geometry_msgs::Twist& message);
-geometry_msgs::Twist toRos(const VelocityCommand& command);
+common::VelocityCommand fromRos(const geometry_msgs::Twist& message);
+geometry_msgs::Twist toRos(const common::VelocityCommand& command);
 // The beams of a scan message (count, first angle, increment, range_max).
-LaserGeometry laserGeometryOf(const sensor_msgs::LaserScan& message);
+common::LaserGeometry laserGeometryOf(const sensor_msgs::LaserScan& message);
 // A scan of `laser` (ranges per beam, metres) in `frame_id`; scan_time = the laser's period.
-sensor_msgs::LaserScan toRos(const std::vector<float>& ranges, const LaserGeometry& laser, double min_range,
+sensor_msgs::LaserScan toRos(const std::vector<float>& ranges, const common::LaserGeometry& laser, double min_range,
                              double scan_time, const std::string& frame_id, const ros::Time& stamp);
 // Pose of `child_frame_id` in `frame_id` with its velocity (base_link frame: linear x, angular z).
-nav_msgs::Odometry toRos(const Pose2& pose, const VelocityCommand& velocity, const std::string& frame_id,
-                         const std::string& child_frame_id, const ros::Time& stamp);
+nav_msgs::Odometry toRos(const common::Pose2& pose, const common::VelocityCommand& velocity,
+                         const std::string& frame_id, const std::string& child_frame_id, const ros::Time& stamp);
 // The transform frame_id -> child_frame_id that places the child at `pose`.
-geometry_msgs::TransformStamped toTransform(const Pose2& pose, const std::string& frame_id,
+geometry_msgs::TransformStamped toTransform(const common::Pose2& pose, const std::string& frame_id,
                                             const std::string& child_frame_id, const ros::Time& stamp);
-Pose2 fromRos(const geometry_msgs::Pose& pose);
+common::Pose2 fromRos(const geometry_msgs::Pose& pose);
 
 // Mapper. A scan as the core's mapper takes it, with the pose of its frame in base_link (`sensor_pose`). Throws
 // InputError for a scan without beams or with a non-finite or zero angle increment.
-RangeScan fromRos(const sensor_msgs::LaserScan& message, const Pose2& sensor_pose);
+common::RangeScan fromRos(const sensor_msgs::LaserScan& message, const common::Pose2& sensor_pose);
 // The planar part of a transform (translation x, y and the yaw of its rotation).
-Pose2 fromRos(const geometry_msgs::Transform& transform);
+common::Pose2 fromRos(const geometry_msgs::Transform& transform);
 // The particles' poses in `frame_id` (weights are not part of the message).
-geometry_msgs::PoseArray toRos(const std::vector<RbpfParticle>& particles, const std::string& frame_id,
+geometry_msgs::PoseArray toRos(const std::vector<mapping::RbpfParticle>& particles, const std::string& frame_id,
                                const ros::Time& stamp);
 
 }  // namespace hidden_rooms

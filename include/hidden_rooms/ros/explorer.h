@@ -17,7 +17,7 @@ namespace hidden_rooms {
 // Parameters of the explorer node (all private, ~name; see docs/ros_api.md and config/explorer.yaml): the
 // policy's (planner, frontiers, follower, passages, replanning, hysteresis, blacklist, done, search turn, obstacle
 // memory) and the node's own.
-struct ExplorerOptions : ExplorationPolicyOptions {
+struct ExplorerOptions : exploration::ExplorationPolicyOptions {
   std::string map_frame = "map";
   std::string base_frame = "base_link";
   double control_rate = 10.0;       // Hz of ROS time: commands (and replanning when due)
@@ -44,27 +44,27 @@ class Explorer {
   void onMap(const nav_msgs::OccupancyGrid::ConstPtr& map);
   void onScan(const sensor_msgs::LaserScan::ConstPtr& scan);
   void onTimer(const ros::TimerEvent& event);
-  bool robotPose(Pose2* pose);
+  bool robotPose(common::Pose2* pose);
   // Stops the robot from outside the policy (stale map, pose or scan): the follower's timers do not count it.
   void holdRobot(const ros::Time& now);
   // Logs the policy's events as ROS_INFO / ROS_WARN lines and publishes exploration_done when it changes.
-  void report(const ExplorationStep& step, const ros::Time& now);
-  void publishCommand(const VelocityCommand& command);
+  void report(const exploration::ExplorationStep& step, const ros::Time& now);
+  void publishCommand(const common::VelocityCommand& command);
   void publishMarkers(const ros::Time& now);
 
   ExplorerOptions options_;
-  ExplorationPolicy policy_;
+  exploration::ExplorationPolicy policy_;
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;
   nav_msgs::OccupancyGrid::ConstPtr latest_map_;
   ros::Time map_received_;  // ROS time the latest map arrived
   bool map_stale_ = false;  // stopped because no map came for map_timeout
   sensor_msgs::LaserScan::ConstPtr latest_scan_;
-  std::vector<Point2> scan_points_;  // latest scan's returns in base_frame
+  std::vector<common::Point2> scan_points_;  // latest scan's returns in base_frame
   bool scan_remembered_ = true;      // the latest scan was given to the policy
   bool stopped_ = true;  // the last command sent was a stop
   // Statistics for the log.
-  std::optional<Pose2> last_pose_;
+  std::optional<common::Pose2> last_pose_;
   double distance_driven_ = 0.0;
   int goals_chosen_ = 0;
   ros::Subscriber map_subscriber_;

@@ -15,7 +15,7 @@ struct MapPublisherOptions {
   std::string map_file;      // map_server yaml; used when set
   std::string environment;   // environment XML, rendered when map_file is empty
   std::string closed_doors;  // doors drawn closed when rendering: numbers/ids, comma-separated, or "all"
-  RenderOptions render;      // resolution, door_width, wall_thickness, margin
+  world::RenderOptions render;  // resolution, door_width, wall_thickness, margin
   std::string frame_id = "map";
 };
 

@@ -21,7 +21,7 @@ namespace hidden_rooms {
 
 // Parameters of the mapper node (all private, ~name; see docs/ros_api.md and config/mapper.yaml).
 struct MapperOptions {
-  RbpfMapperOptions rbpf;             // ~config_file (MRPT ini), ~seed
+  mapping::RbpfMapperOptions rbpf;  // ~config_file (MRPT ini), ~seed
   std::string scan_topic = "base_scan";
   std::string map_frame = "map";
   std::string odom_frame = "odom";
@@ -48,7 +48,7 @@ class Mapper {
   // Loads the MRPT options (throws InputError when it cannot); does not wait for anything.
   Mapper(ros::NodeHandle nh, const MapperOptions& options);
 
-  const RbpfMapper& mapper() const { return *mapper_; }
+  const mapping::RbpfMapper& mapper() const { return *mapper_; }
   // Scans given to the filter / dropped because their odometry never arrived / ignored on arrival (stamped
   // before the last one or too far ahead, no valid range).
   int scansProcessed() const { return processed_; }
@@ -66,7 +66,7 @@ class Mapper {
   bool onSaveMap(hidden_rooms::SaveMap::Request& request, hidden_rooms::SaveMap::Response& response);
 
   MapperOptions options_;
-  std::unique_ptr<RbpfMapper> mapper_;
+  std::unique_ptr<mapping::RbpfMapper> mapper_;
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;
   tf2_ros::TransformBroadcaster tf_broadcaster_;
@@ -85,7 +85,7 @@ class Mapper {
   // map -> odom after the last processed scan and the stamp it was last sent with: written by the scan callback,
   // read by the tf timer's thread.
   std::mutex transform_mutex_;
-  std::optional<Pose2> map_to_odom_;
+  std::optional<common::Pose2> map_to_odom_;
   ros::Time last_tf_stamp_;
   // The tf timer's own queue and thread (declared last: the thread stops before the timer and queue go).
   ros::CallbackQueue tf_queue_;

@@ -24,29 +24,29 @@ namespace hidden_rooms {
 // leave nothing behind), then per predicted room a filled area (namespace "rooms", the cells of its label in
 // `labels`, colour of roomColour()), its outline ("outlines"), a text with door id and area ("labels"); every
 // door as a thick line across its width ("doors": red when its room is predicted, grey when not placed).
-visualization_msgs::MarkerArray toMarkers(const OccupancyGrid& map, const DoorsFile& doors,
-                                          const std::vector<RoomPrediction>& rooms, const cv::Mat1w& labels,
+visualization_msgs::MarkerArray toMarkers(const common::OccupancyGrid& map, const common::DoorsFile& doors,
+                                          const std::vector<prediction::RoomPrediction>& rooms, const cv::Mat1w& labels,
                                           const std::string& frame_id, const ros::Time& stamp);
 // Debug overlays of the layout analysis: its extended lines ("debug_extended_lines": walls blue, door-pair lines
 // orange, boundary lines grey) and its cells ("debug_in_out_cells": IN cells green, OUT cells red, translucent).
-visualization_msgs::MarkerArray toDebugMarkers(const OccupancyGrid& map, const Layout& layout,
+visualization_msgs::MarkerArray toDebugMarkers(const common::OccupancyGrid& map, const prediction::Layout& layout,
                                                const std::string& frame_id, const ros::Time& stamp);
 
 // What the explorer shows of one plan (map frame).
 struct ExplorationView {
-  const FrontierMap* frontiers = nullptr;
+  const exploration::FrontierMap* frontiers = nullptr;
   int goal_frontier_label = -1;  // the frontier the goal lies on; -1 without a goal
-  std::optional<Point2> goal;
-  std::vector<Point2> path;
-  std::vector<Point2> blacklist;
-  std::vector<Point2> blocked_passages;
+  std::optional<common::Point2> goal;
+  std::vector<common::Point2> path;
+  std::vector<common::Point2> blacklist;
+  std::vector<common::Point2> blocked_passages;
   double blocked_passage_radius = 0.0;  // metres
 };
 
 // The explorer's overlays in `frame_id`: the frontier cells ("frontiers": the goal's frontier orange, others blue),
 // the goal ("goal", orange sphere), the path to it ("path", green line), blacklisted places ("blacklist", red) and
 // blocked passages ("blocked_passages", purple discs of their radius).
-visualization_msgs::MarkerArray toMarkers(const OccupancyGrid& map, const ExplorationView& view,
+visualization_msgs::MarkerArray toMarkers(const common::OccupancyGrid& map, const ExplorationView& view,
                                           const std::string& frame_id, const ros::Time& stamp);
 
 }  // namespace hidden_rooms

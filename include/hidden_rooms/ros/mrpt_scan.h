@@ -17,7 +17,7 @@ namespace hidden_rooms {
 // below range_min or at or beyond 0.99 range_max (no return) are invalid: kept at range_max, not inserted nor
 // matched. Throws InputError for fewer than 2 beams, a zero or non-finite angle increment, a
 // non-positive or non-finite range_max or a non-finite sensor pose.
-mrpt::obs::CObservation2DRangeScan toMrptScan(const sensor_msgs::LaserScan& message, const Pose2& sensor_pose);
+mrpt::obs::CObservation2DRangeScan toMrptScan(const sensor_msgs::LaserScan& message, const common::Pose2& sensor_pose);
 
 // True when `range` is a return of `message` by toMrptScan's rule: finite and strictly between range_min and
 // 0.99 range_max.

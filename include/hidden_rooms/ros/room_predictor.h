@@ -55,7 +55,7 @@ class RoomPredictorNode {
   void predict(const PredictRooms::Request& request, PredictRooms::Response* response);
 
   RoomPredictorOptions options_;
-  std::optional<DoorsFile> default_doors_;
+  std::optional<common::DoorsFile> default_doors_;
   std::map<std::string, double> file_parameters_;
   nav_msgs::OccupancyGrid::ConstPtr latest_map_;
   std::string map_topic_;

@@ -24,8 +24,8 @@ struct SimulatorOptions {
   std::string bitmap;        // Stage-style image (dark = wall), with ~bitmap_resolution
   double bitmap_resolution = 0.05;  // metres per pixel of ~bitmap; its lower-left corner is the world origin
   std::string closed_doors;  // environment doors closed at start: numbers or ids, comma-separated, or "all"
-  RenderOptions render;      // door_width, wall_thickness (the world's walls as rendered)
-  SimulationOptions simulation;
+  world::RenderOptions render;  // door_width, wall_thickness (the world's walls as rendered)
+  simulation::SimulationOptions simulation;
   double realtime_factor = 1.0;   // simulated seconds per wall-clock second; 0 = as fast as possible
   double laser_rate = 10.0;       // Hz of simulated time
   double odom_rate = 20.0;        // Hz of simulated time (odom, base_pose_ground_truth, tf odom -> base_link)
@@ -54,7 +54,7 @@ class Simulator {
   void run();
   // One physics step and whatever is due after it (publications at their rates). Callbacks are not handled.
   void step();
-  const Simulation& simulation() const { return *simulation_; }
+  const simulation::Simulation& simulation() const { return *simulation_; }
   ros::Time now() const;
 
  private:
@@ -66,7 +66,7 @@ class Simulator {
   void publishOdometry();
 
   SimulatorOptions options_;
-  std::unique_ptr<Simulation> simulation_;
+  std::unique_ptr<simulation::Simulation> simulation_;
   uint64_t laser_period_steps_ = 1;
   uint64_t odom_period_steps_ = 1;
   uint64_t clock_period_steps_ = 1;

@@ -18,7 +18,7 @@
 class b2World;
 class b2Body;
 
-namespace hidden_rooms {
+namespace hidden_rooms::simulation {
 
 // The static part of a simulated world (world frame = environment / map frame, metres): solid convex polygons
 // and doors whose leaves can be opened and closed at run time.
@@ -26,14 +26,14 @@ struct SimulationWorld {
   struct DoorLeaf {
     std::string id;                // PORTAL id of the environment
     int number = 0;                // 1-based door number of the environment
-    std::vector<Polygon> pieces;   // the wall a closed door puts back; empty: the door cannot open (exterior)
+    std::vector<common::Polygon> pieces;  // the wall a closed door puts back; empty: the door cannot open (exterior)
     bool closed = false;
   };
-  std::vector<Polygon> walls;      // convex (rectangles), collinear pieces merged
+  std::vector<common::Polygon> walls;  // convex (rectangles), collinear pieces merged
   std::vector<DoorLeaf> doors;     // indexed like Environment::doors
   // Where the robot may be: free cells (-1 unknown, 0 free, 100 occupied) and, for environments, the label of
   // the space each free cell belongs to (1 + index; 0 elsewhere); used to choose a default start pose.
-  OccupancyGrid free_space;
+  common::OccupancyGrid free_space;
   cv::Mat1w space_labels;
   std::vector<std::string> space_kinds;  // per space: its <label> (CORRIDOR, OFFICE, ...)
   // Grid worlds: the cell size of the source grid (the grid caster uses it); 0 for environments.
@@ -46,17 +46,17 @@ struct SimulationWorld {
 // Walls and doors of an environment as renderEnvironment draws them (wallGeometry): every door between two
 // spaces becomes an openable leaf, closed when it is in `closed_door_indices` or its status is CLOSED; doors to
 // the outside stay wall. Throws InputError for bad render options or door indices.
-SimulationWorld worldFromEnvironment(const Environment& environment, const std::set<int>& closed_door_indices,
-                                     const RenderOptions& options = RenderOptions());
+SimulationWorld worldFromEnvironment(const world::Environment& environment, const std::set<int>& closed_door_indices,
+                                     const world::RenderOptions& options = world::RenderOptions());
 // A Stage-style bitmap world: occupied cells merged into few axis-aligned boxes (row runs stacked while the
 // next row has the same run). Unknown cells are neither solid nor places to start. Throws InputError for an
 // empty grid or one without free cells.
-SimulationWorld worldFromGrid(const OccupancyGrid& grid);
+SimulationWorld worldFromGrid(const common::OccupancyGrid& grid);
 
 // Merges rectangles (as segmentRectangle-like 4-vertex polygons) lying on one line with the same thickness
 // into one rectangle per connected run; other polygons pass unchanged. Keeps the fixture count small: floor
 // plans draw shared walls twice and split straight walls into many segments.
-std::vector<Polygon> mergeCollinearRectangles(const std::vector<Polygon>& rectangles);
+std::vector<common::Polygon> mergeCollinearRectangles(const std::vector<common::Polygon>& rectangles);
 
 enum class LaserCasterKind { kBox2d, kGrid };
 const char* toString(LaserCasterKind kind);
@@ -81,7 +81,7 @@ struct LaserOptions {
   double max_range = 30.0;                  // metres
   double range_noise = 0.01;                // standard deviation of the Gaussian range noise, metres
   double max_range_probability = 0.0;      // chance of a spurious max-range return per beam
-  Pose2 mount{0.2, 0.0, 0.0};               // base_link -> base_laser_link
+  common::Pose2 mount{0.2, 0.0, 0.0};      // base_link -> base_laser_link
   LaserCasterKind caster = LaserCasterKind::kBox2d;
   double grid_resolution = 0.02;            // cell size of the grid caster (environments), metres
 };
@@ -101,7 +101,7 @@ struct SimulationOptions {
   LaserOptions laser;
   OdometryNoiseOptions odometry_noise;
   // Unset: the free point farthest from any wall, in a corridor when the environment labels one, yaw 0.
-  std::optional<Pose2> start_pose;
+  std::optional<common::Pose2> start_pose;
 };
 
 // Throws InputError("simulation options", ...) naming the first bad option.
@@ -131,26 +131,26 @@ class Simulation {
 
   // The velocity the robot should reach (clamped to the limits, approached within the acceleration limits).
   // Resets the watchdog. Throws InputError for a non-finite command (the current one stays).
-  void setCommand(const VelocityCommand& command);
+  void setCommand(const common::VelocityCommand& command);
   // Advances one physics step: watchdog, acceleration limits, Box2D step (collisions), odometry.
   void step();
 
   double time() const { return static_cast<double>(steps_) * options_.physics_step; }
   uint64_t steps() const { return steps_; }
-  Pose2 truePose() const;      // base_link in the world frame
-  Pose2 laserPose() const;     // base_laser_link in the world frame
-  Pose2 odometryPose() const;  // base_link in the odom frame (starts at 0 at the start pose)
-  VelocityCommand velocity() const { return velocity_; }  // measured over the last step, base_link frame
-  VelocityCommand odometryVelocity() const;               // the same with the odometry's error
-  const Pose2& startPose() const { return start_pose_; }
+  common::Pose2 truePose() const;      // base_link in the world frame
+  common::Pose2 laserPose() const;     // base_laser_link in the world frame
+  common::Pose2 odometryPose() const;  // base_link in the odom frame (starts at 0 at the start pose)
+  common::VelocityCommand velocity() const { return velocity_; }  // measured over the last step, base_link frame
+  common::VelocityCommand odometryVelocity() const;               // the same with the odometry's error
+  const common::Pose2& startPose() const { return start_pose_; }
 
   // A scan at the current pose from the configured caster, with range noise and spurious max-range returns.
   void scan(std::vector<float>* ranges);
   // A noise-free scan from the given caster (for benchmarks and tests).
   void scanWith(LaserCasterKind kind, std::vector<float>* ranges) const;
-  const LaserGeometry& laserGeometry() const { return laser_; }
+  const common::LaserGeometry& laserGeometry() const { return laser_; }
   // True when a wall or closed door lies within `radius` of `point` (Box2D geometry, exact).
-  bool solidNear(const Point2& point, double radius) const;
+  bool solidNear(const common::Point2& point, double radius) const;
   // Cell size of the grid caster's grid, metres.
   double gridResolution() const { return wall_grid_.resolution; }
 
@@ -170,22 +170,22 @@ class Simulation {
 
   SimulationWorld world_;
   SimulationOptions options_;
-  LaserGeometry laser_;
+  common::LaserGeometry laser_;
   std::unique_ptr<b2World> physics_;
   b2Body* robot_ = nullptr;
   std::vector<b2Body*> door_bodies_;  // per door, null when it has no leaf
   std::unique_ptr<Box2dLaserCaster> box2d_caster_;
   std::unique_ptr<GridLaserCaster> grid_caster_;
-  OccupancyGrid wall_grid_;  // the walls alone, for the grid caster; closed leaves are added on top
+  common::OccupancyGrid wall_grid_;  // the walls alone, for the grid caster; closed leaves are added on top
   std::mt19937_64 random_;
-  Pose2 start_pose_;
+  common::Pose2 start_pose_;
   uint64_t steps_ = 0;
-  VelocityCommand target_;
-  VelocityCommand commanded_;
-  VelocityCommand velocity_;
+  common::VelocityCommand target_;
+  common::VelocityCommand commanded_;
+  common::VelocityCommand velocity_;
   double last_command_time_ = 0.0;
-  Pose2 odometry_;
+  common::Pose2 odometry_;
   double odometry_error_[3] = {0.0, 0.0, 0.0};
 };
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::simulation

@@ -8,7 +8,7 @@
 #include "hidden_rooms/common/doors_file.h"
 #include "hidden_rooms/common/geometry.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::world {
 
 // The thesis's environment XML (KTH floor-plan schema, docs/method.md#exploration-runs) as a metric model.
 //
@@ -22,8 +22,8 @@ enum class SegmentClass { kWall, kPortal };
 // One <linesegment> of a space's <space_representation>. A PORTAL usually has a = b (the door centre).
 struct LineSegment {
   std::string id;
-  Point2 a;
-  Point2 b;
+  common::Point2 a;
+  common::Point2 b;
   SegmentClass segment_class = SegmentClass::kWall;
   std::string type = "EXPLICIT";    // EXPLICIT | IMPLICIT, kept for the round trip
   std::string features = "NORMAL";  // kept for the round trip
@@ -43,7 +43,7 @@ struct Space {
   std::string id;
   std::string type;   // <labels><type>
   std::string label;  // <labels><label>: CORRIDOR, OFFICE, ...
-  Polygon outline;    // <bounding_polygon>, metres, repeated vertices removed; < 3 if degenerate
+  common::Polygon outline;  // <bounding_polygon>, metres, repeated vertices removed; < 3 if degenerate
   std::vector<LineSegment> segments;
   std::vector<PortalLink> portals;
 };
@@ -54,9 +54,9 @@ enum class DoorStatus { kUnspecified, kOpen, kClosed };
 struct Door {
   std::string id;                   // the PORTAL linesegment id
   int number = 0;                   // 1-based, order of first appearance in the file; used in doors.yaml
-  Point2 centre;                    // metres
+  common::Point2 centre;            // metres
   double wall_angle = 0.0;          // direction of the wall the door sits in, radians in [0, pi)
-  DoorOrientation orientation = DoorOrientation::kAlongX;
+  common::DoorOrientation orientation = common::DoorOrientation::kAlongX;
   std::vector<int> space_indices;   // spaces it joins (indices into Environment::spaces); 1 = exterior door
   DoorStatus status = DoorStatus::kUnspecified;  // the thesis's optional <status> element
   bool implicit = false;            // PORTAL of type IMPLICIT (an opening without a door leaf)
@@ -79,7 +79,7 @@ struct Environment {
   // Index of the door with this XML id or this 1-based number (given as text); -1 when there is none.
   int findDoor(const std::string& id_or_number) const;
   // Axis-aligned bounds of all outlines and segments, metres: {min, max}.
-  std::pair<Point2, Point2> bounds() const;
+  std::pair<common::Point2, common::Point2> bounds() const;
 };
 
 // Reads an environment XML. Throws InputError naming the file and the problem (malformed XML, missing or
@@ -109,4 +109,4 @@ std::vector<int> closableDoors(const Environment& environment);
 // Index of the space behind a closable door (the space whose only door it is), or -1.
 int roomBehindDoor(const Environment& environment, int door_index);
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::world

@@ -11,7 +11,7 @@
 #include "hidden_rooms/common/occupancy_grid.h"
 #include "hidden_rooms/world/environment.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::world {
 
 struct RenderOptions {
   double resolution = 0.05;  // metres per cell
@@ -25,9 +25,9 @@ struct RenderOptions {
 // Ground truth of an environment in the map frame (the map frame is the environment frame: the grid's
 // origin is its lower-left corner in environment coordinates).
 struct RenderedEnvironment {
-  OccupancyGrid map;        // free inside spaces, walls occupied, unknown outside
+  common::OccupancyGrid map;  // free inside spaces, walls occupied, unknown outside
   cv::Mat1w space_labels;   // per cell: 1 + index of the space whose free cells it belongs to, 0 elsewhere
-  DoorsFile closed_doors;   // the closed doors, frame "map"
+  common::DoorsFile closed_doors;  // the closed doors, frame "map"
   double wall_thickness = 0.0;  // metres, as drawn
 };
 
@@ -44,9 +44,9 @@ RenderedEnvironment renderEnvironment(const Environment& environment, const std:
 // InputError for bad options or a door index that does not exist.
 struct WallGeometry {
   double thickness = 0.0;  // metres, as drawn
-  std::vector<Polygon> walls;
-  std::vector<std::vector<Polygon>> door_leaves;
-  std::vector<Polygon> door_openings;
+  std::vector<common::Polygon> walls;
+  std::vector<std::vector<common::Polygon>> door_leaves;
+  std::vector<common::Polygon> door_openings;
 };
 WallGeometry wallGeometry(const Environment& environment, const std::set<int>& open_door_indices,
                           const RenderOptions& options = RenderOptions());
@@ -56,8 +56,8 @@ WallGeometry wallGeometry(const Environment& environment, const std::set<int>& o
 // of the room behind the k-th closed door (the order of `closed_doors`). Throws InputError for a closed door
 // that is not closable (its room has other doors, so nothing would be hidden behind it).
 struct HiddenRoomsCase {
-  OccupancyGrid map;
-  DoorsFile closed_doors;
+  common::OccupancyGrid map;
+  common::DoorsFile closed_doors;
   cv::Mat1w true_rooms;
 };
 HiddenRoomsCase hideClosedRooms(const Environment& environment, const RenderedEnvironment& rendered);
@@ -66,4 +66,4 @@ HiddenRoomsCase hideClosedRooms(const Environment& environment, const RenderedEn
 // numbers.
 cv::Mat3b renderPreview(const Environment& environment, const RenderedEnvironment& rendered);
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::world

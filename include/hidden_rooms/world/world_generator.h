@@ -5,7 +5,7 @@
 
 #include "hidden_rooms/world/environment.h"
 
-namespace hidden_rooms {
+namespace hidden_rooms::world {
 
 // Size classes by number of closable doors, as in the thesis (docs/method.md#batch-analysis): small < 10, medium
 // 10..15, large >= 16.
@@ -22,4 +22,4 @@ SizeClass parseSizeClass(const std::string& text);
 // every space is reachable with all doors open, and the same seed and class always give the same world.
 Environment generateWorld(std::uint32_t seed, SizeClass size_class);
 
-}  // namespace hidden_rooms
+}  // namespace hidden_rooms::world
