@@ -2,6 +2,23 @@
 
 namespace hidden_rooms::exploration {
 
+const common::OptionTable<ExplorationPolicyOptions>& explorationPolicyOptionTable() {
+  using O = ExplorationPolicyOptions;
+  static const common::OptionTable<O> table{
+      {"replan_interval", &O::replan_interval, "seconds between replans without a new map; 0 = on new maps only",
+       common::atLeast(0)},
+      {"goal_hysteresis", &O::goal_hysteresis, "path cost (metres) by which another goal must be cheaper",
+       common::atLeast(0)},
+      {"blacklist_radius", &O::blacklist_radius, "metres around a reached or failed goal where no goal is chosen",
+       common::atLeast(0)},
+      {"done_confirmations", &O::done_confirmations, "new maps in a row without a reachable frontier before done",
+       common::atLeast(1)},
+      {"search_angular_velocity", &O::search_angular_velocity, "rad/s turned in place while there is no goal"},
+      {"obstacle_memory", &O::obstacle_memory, "seconds the laser points of past scans are kept", common::atLeast(0)},
+  };
+  return table;
+}
+
 namespace {
 
 // Half ROS time's resolution: time differences closer than this to a threshold reach it.

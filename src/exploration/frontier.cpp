@@ -101,6 +101,32 @@ size_t Blacklist::releaseFailed() {
   return removePoints(&failed_points, &points);
 }
 
+const common::OptionTable<FrontierOptions>& frontierOptionTable() {
+  using O = FrontierOptions;
+  static const common::OptionTable<O> table{
+      {"min_frontier_cells", &O::min_frontier_cells, "smaller frontiers are dropped", common::atLeast(1)},
+      {"min_unknown_cells", &O::min_unknown_cells, "smaller unknown areas (4-connected) make no frontier",
+       common::atLeast(1)},
+      {"goal_reach", &O::goal_reach, "metres: a goal lies within this of a frontier cell", common::atLeast(0)},
+      {"min_goal_distance", &O::min_goal_distance, "metres: and at least this far from the robot",
+       common::atLeast(0)},
+  };
+  return table;
+}
+
+const common::OptionTable<BlockedPassagesOptions>& blockedPassagesOptionTable() {
+  using O = BlockedPassagesOptions;
+  static const common::OptionTable<O> table{
+      {"blocked_passage_failures", &O::failures,
+       "goals failed from one place in one direction that block the path ahead; 0 = off", common::atLeast(0)},
+      {"blocked_passage_length", &O::length, "metres of the failed path ahead of the robot that are blocked",
+       common::atLeast(0)},
+      {"blocked_passage_radius", &O::radius, "metres blocked around each point of that stretch",
+       common::atLeast(0)},
+  };
+  return table;
+}
+
 void validate(const BlockedPassagesOptions& options) {
   const auto require = [](bool ok, const std::string& what) {
     if (!ok) throw common::InputError("explorer options", what);

@@ -19,26 +19,36 @@ constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
 }  // namespace
 
+const common::OptionTable<GridPlannerOptions>& gridPlannerOptionTable() {
+  using O = GridPlannerOptions;
+  static const common::OptionTable<O> table{
+      {"free_threshold", &O::free_threshold, "map values 0..this are free", common::between(0, 100)},
+      {"occupied_threshold", &O::occupied_threshold, "map values >= this are obstacles", common::between(0, 100)},
+      {"robot_radius", &O::robot_radius, "metres: the clearance goals always keep and paths keep where they can",
+       common::atLeast(0)},
+      {"min_clearance", &O::min_clearance, "metres: obstacle inflation, the hard limit for the robot's centre",
+       common::atLeast(0)},
+      {"narrow_cost_factor", &O::narrow_cost_factor, "cost factor of cells closer than robot_radius to an obstacle",
+       common::atLeast(1)},
+      {"cost_radius", &O::cost_radius, "metres: cells this close to an obstacle cost extra", common::atLeast(0)},
+      {"cost_weight", &O::cost_weight, "extra cost at robot_radius, falling linearly to cost_radius",
+       common::atLeast(0)},
+      {"start_escape_radius", &O::start_escape_radius,
+       "metres: a robot in the inflation plans from the nearest traversable cell within this", common::atLeast(0)},
+      {"smoothing_window", &O::smoothing_window, "metres: half-width of the path's moving average; 0 = none",
+       common::atLeast(0)},
+  };
+  return table;
+}
+
 void validate(const GridPlannerOptions& options) {
+  common::validateOptions(gridPlannerOptionTable(), options);
   const auto require = [](bool ok, const std::string& what) {
     if (!ok) throw common::InputError("explorer options", what);
   };
-  require(options.free_threshold >= 0 && options.free_threshold < options.occupied_threshold &&
-              options.occupied_threshold <= 100,
-          "need 0 <= free_threshold < occupied_threshold <= 100");
-  require(std::isfinite(options.robot_radius) && options.robot_radius >= 0.0, "robot_radius must be >= 0");
-  require(std::isfinite(options.min_clearance) && options.min_clearance >= 0.0 &&
-              options.min_clearance <= options.robot_radius,
-          "need 0 <= min_clearance <= robot_radius");
-  require(std::isfinite(options.narrow_cost_factor) && options.narrow_cost_factor >= 1.0,
-          "narrow_cost_factor must be >= 1");
-  require(std::isfinite(options.cost_radius) && options.cost_radius >= options.robot_radius,
-          "cost_radius must be >= robot_radius");
-  require(std::isfinite(options.cost_weight) && options.cost_weight >= 0.0, "cost_weight must be >= 0");
-  require(std::isfinite(options.start_escape_radius) && options.start_escape_radius >= 0.0,
-          "start_escape_radius must be >= 0");
-  require(std::isfinite(options.smoothing_window) && options.smoothing_window >= 0.0,
-          "smoothing_window must be >= 0");
+  require(options.free_threshold < options.occupied_threshold, "need free_threshold < occupied_threshold");
+  require(options.min_clearance <= options.robot_radius, "need min_clearance <= robot_radius");
+  require(options.cost_radius >= options.robot_radius, "cost_radius must be >= robot_radius");
 }
 
 GridPlanner::GridPlanner(const GridPlannerOptions& options) : options_(options) { validate(options_); }

@@ -19,40 +19,47 @@ common::Point2 toRobotFrame(const common::Pose2& pose, const common::Point2& poi
 
 }  // namespace
 
-void validate(const PathFollowerOptions& options) {
-  const auto positive = [](double value, const char* name) {
-    if (!std::isfinite(value) || value <= 0.0)
-      throw common::InputError("explorer options", std::string(name) + " must be positive");
+const common::OptionTable<PathFollowerOptions>& pathFollowerOptionTable() {
+  using O = PathFollowerOptions;
+  const common::ParameterRange positive = common::above(0), non_negative = common::atLeast(0);
+  static const common::OptionTable<O> table{
+      {"max_linear_velocity", &O::max_linear_velocity, "m/s", positive},
+      {"max_angular_velocity", &O::max_angular_velocity, "rad/s", positive},
+      {"lookahead", &O::lookahead, "metres: pure pursuit distance along the path", positive},
+      {"goal_tolerance", &O::goal_tolerance, "metres: the goal is reached within this", positive},
+      {"rotate_in_place_angle", &O::rotate_in_place_angle,
+       "rad: a larger heading error to the pursued point turns in place", positive},
+      {"heading_gain", &O::heading_gain, "rad/s per rad of heading error when turning in place", positive},
+      {"footprint_length", &O::footprint_length, "metres: the robot box for the laser lane", positive},
+      {"footprint_width", &O::footprint_width, "metres: the robot box for the laser lane", positive},
+      {"side_margin", &O::side_margin, "metres of lane beside, ahead of and behind the footprint", non_negative},
+      {"stop_distance", &O::stop_distance, "metres: no forward motion with less free space ahead", non_negative},
+      {"deceleration", &O::deceleration, "m/s^2: the laser speed cap sqrt(2 deceleration free)", positive},
+      {"creep_velocity", &O::creep_velocity, "m/s: moving away from near points while turning in place",
+       non_negative},
+      {"arc_horizon", &O::arc_horizon, "seconds of the commanded arc checked against the laser; 0 = no check",
+       non_negative},
+      {"doorway_distance", &O::doorway_distance, "metres: points this close on both sides make a doorway",
+       non_negative},
+      {"doorway_angular_velocity", &O::doorway_angular_velocity, "rad/s: the turn rate cap in a doorway",
+       non_negative},
+      {"stall_timeout", &O::stall_timeout, "seconds without stall_distance or stall_angle start a recovery",
+       positive},
+      {"stall_distance", &O::stall_distance, "metres", non_negative},
+      {"stall_angle", &O::stall_angle, "rad", non_negative},
+      {"backoff_time", &O::backoff_time, "recovery: seconds backing off", non_negative},
+      {"backoff_velocity", &O::backoff_velocity, "recovery: m/s backing off", non_negative},
+      {"recovery_rotate_time", &O::recovery_rotate_time, "recovery: seconds turning towards the freer side",
+       non_negative},
+      {"progress_timeout", &O::progress_timeout,
+       "seconds in which the remaining path must shrink by progress_distance, else the goal fails", positive},
+      {"progress_distance", &O::progress_distance, "metres", non_negative},
+      {"max_recoveries", &O::max_recoveries, "recoveries per goal before it fails", non_negative},
   };
-  const auto non_negative = [](double value, const char* name) {
-    if (!std::isfinite(value) || value < 0.0)
-      throw common::InputError("explorer options", std::string(name) + " must be >= 0");
-  };
-  positive(options.max_linear_velocity, "max_linear_velocity");
-  positive(options.max_angular_velocity, "max_angular_velocity");
-  positive(options.lookahead, "lookahead");
-  positive(options.goal_tolerance, "goal_tolerance");
-  positive(options.rotate_in_place_angle, "rotate_in_place_angle");
-  positive(options.heading_gain, "heading_gain");
-  positive(options.footprint_length, "footprint_length");
-  positive(options.footprint_width, "footprint_width");
-  non_negative(options.side_margin, "side_margin");
-  non_negative(options.stop_distance, "stop_distance");
-  positive(options.deceleration, "deceleration");
-  positive(options.stall_timeout, "stall_timeout");
-  non_negative(options.stall_distance, "stall_distance");
-  non_negative(options.stall_angle, "stall_angle");
-  non_negative(options.backoff_time, "backoff_time");
-  non_negative(options.backoff_velocity, "backoff_velocity");
-  non_negative(options.creep_velocity, "creep_velocity");
-  non_negative(options.arc_horizon, "arc_horizon");
-  non_negative(options.doorway_distance, "doorway_distance");
-  non_negative(options.doorway_angular_velocity, "doorway_angular_velocity");
-  non_negative(options.recovery_rotate_time, "recovery_rotate_time");
-  positive(options.progress_timeout, "progress_timeout");
-  non_negative(options.progress_distance, "progress_distance");
-  if (options.max_recoveries < 0) throw common::InputError("explorer options", "max_recoveries must be >= 0");
+  return table;
 }
+
+void validate(const PathFollowerOptions& options) { common::validateOptions(pathFollowerOptionTable(), options); }
 
 const char* toString(FollowerState state) {
   switch (state) {

@@ -10,99 +10,51 @@
 #include "hidden_rooms/common/range_scan.h"
 #include "hidden_rooms/ros/conversions.h"
 #include "hidden_rooms/ros/markers.h"
+#include "hidden_rooms/ros/parameters.h"
 
 namespace hidden_rooms {
 
+const common::OptionTable<ExplorerOptions>& explorerNodeOptionTable() {
+  using O = ExplorerOptions;
+  static const common::OptionTable<O> table{
+      {"map_frame", &O::map_frame, "frame of the map", common::anyFinite(), true},
+      {"base_frame", &O::base_frame, "frame of the robot", common::anyFinite(), true},
+      {"control_rate", &O::control_rate, "Hz (ROS time) of cmd_vel", common::above(0)},
+      {"scan_timeout", &O::scan_timeout, "seconds: an older scan stops the robot", common::above(0)},
+      {"pose_timeout", &O::pose_timeout, "seconds: an older map -> base transform stops the robot",
+       common::above(0)},
+      {"map_timeout", &O::map_timeout, "seconds without a new map stop the robot; 0 = never", common::atLeast(0)},
+  };
+  return table;
+}
+
+std::vector<common::OptionDescription> explorerParameters() {
+  std::vector<common::OptionDescription> rows;
+  const auto add = [&rows](const std::vector<common::OptionDescription>& more) {
+    rows.insert(rows.end(), more.begin(), more.end());
+  };
+  add(common::describeOptions(explorerNodeOptionTable()));
+  add(common::describeOptions(exploration::explorationPolicyOptionTable()));
+  add(common::describeOptions(exploration::gridPlannerOptionTable()));
+  add(common::describeOptions(exploration::frontierOptionTable()));
+  add(common::describeOptions(exploration::pathFollowerOptionTable()));
+  add(common::describeOptions(exploration::blockedPassagesOptionTable()));
+  return rows;
+}
+
 ExplorerOptions readExplorerOptions(const ros::NodeHandle& nh) {
   ExplorerOptions options;
-  exploration::GridPlannerOptions& planner = options.planner;
-  nh.param("free_threshold", planner.free_threshold, planner.free_threshold);
-  nh.param("occupied_threshold", planner.occupied_threshold, planner.occupied_threshold);
-  nh.param("robot_radius", planner.robot_radius, planner.robot_radius);
-  nh.param("min_clearance", planner.min_clearance, planner.min_clearance);
-  nh.param("narrow_cost_factor", planner.narrow_cost_factor, planner.narrow_cost_factor);
-  nh.param("cost_radius", planner.cost_radius, planner.cost_radius);
-  nh.param("cost_weight", planner.cost_weight, planner.cost_weight);
-  nh.param("start_escape_radius", planner.start_escape_radius, planner.start_escape_radius);
-  nh.param("smoothing_window", planner.smoothing_window, planner.smoothing_window);
-  validate(planner);
-
-  exploration::FrontierOptions& frontiers = options.frontiers;
-  frontiers.free_threshold = planner.free_threshold;
-  frontiers.occupied_threshold = planner.occupied_threshold;
-  nh.param("min_frontier_cells", frontiers.min_frontier_cells, frontiers.min_frontier_cells);
-  nh.param("min_unknown_cells", frontiers.min_unknown_cells, frontiers.min_unknown_cells);
-  nh.param("goal_reach", frontiers.goal_reach, frontiers.goal_reach);
-  nh.param("min_goal_distance", frontiers.min_goal_distance, frontiers.min_goal_distance);
-  if (frontiers.min_frontier_cells < 1) throw common::InputError("~min_frontier_cells", "must be at least 1");
-  if (frontiers.min_unknown_cells < 1) throw common::InputError("~min_unknown_cells", "must be at least 1");
-  if (!std::isfinite(frontiers.goal_reach) || frontiers.goal_reach < 0.0)
-    throw common::InputError("~goal_reach", "must be zero or positive");
-  if (!std::isfinite(frontiers.min_goal_distance) || frontiers.min_goal_distance < 0.0)
-    throw common::InputError("~min_goal_distance", "must be zero or positive");
-
-  exploration::PathFollowerOptions& follower = options.follower;
-  nh.param("max_linear_velocity", follower.max_linear_velocity, follower.max_linear_velocity);
-  nh.param("max_angular_velocity", follower.max_angular_velocity, follower.max_angular_velocity);
-  nh.param("lookahead", follower.lookahead, follower.lookahead);
-  nh.param("goal_tolerance", follower.goal_tolerance, follower.goal_tolerance);
-  nh.param("rotate_in_place_angle", follower.rotate_in_place_angle, follower.rotate_in_place_angle);
-  nh.param("heading_gain", follower.heading_gain, follower.heading_gain);
-  nh.param("footprint_length", follower.footprint_length, follower.footprint_length);
-  nh.param("footprint_width", follower.footprint_width, follower.footprint_width);
-  nh.param("side_margin", follower.side_margin, follower.side_margin);
-  nh.param("stop_distance", follower.stop_distance, follower.stop_distance);
-  nh.param("deceleration", follower.deceleration, follower.deceleration);
-  nh.param("creep_velocity", follower.creep_velocity, follower.creep_velocity);
-  nh.param("arc_horizon", follower.arc_horizon, follower.arc_horizon);
-  nh.param("doorway_distance", follower.doorway_distance, follower.doorway_distance);
-  nh.param("doorway_angular_velocity", follower.doorway_angular_velocity, follower.doorway_angular_velocity);
-  nh.param("stall_timeout", follower.stall_timeout, follower.stall_timeout);
-  nh.param("stall_distance", follower.stall_distance, follower.stall_distance);
-  nh.param("stall_angle", follower.stall_angle, follower.stall_angle);
-  nh.param("backoff_time", follower.backoff_time, follower.backoff_time);
-  nh.param("backoff_velocity", follower.backoff_velocity, follower.backoff_velocity);
-  nh.param("recovery_rotate_time", follower.recovery_rotate_time, follower.recovery_rotate_time);
-  nh.param("progress_timeout", follower.progress_timeout, follower.progress_timeout);
-  nh.param("progress_distance", follower.progress_distance, follower.progress_distance);
-  nh.param("max_recoveries", follower.max_recoveries, follower.max_recoveries);
-  validate(follower);
-
-  exploration::BlockedPassagesOptions& passages = options.passages;
-  nh.param("blocked_passage_failures", passages.failures, passages.failures);
-  nh.param("blocked_passage_length", passages.length, passages.length);
-  nh.param("blocked_passage_radius", passages.radius, passages.radius);
-  validate(passages);
-
-  nh.param("map_frame", options.map_frame, options.map_frame);
-  nh.param("base_frame", options.base_frame, options.base_frame);
-  nh.param("control_rate", options.control_rate, options.control_rate);
-  nh.param("replan_interval", options.replan_interval, options.replan_interval);
-  nh.param("goal_hysteresis", options.goal_hysteresis, options.goal_hysteresis);
-  nh.param("blacklist_radius", options.blacklist_radius, options.blacklist_radius);
-  nh.param("done_confirmations", options.done_confirmations, options.done_confirmations);
-  nh.param("search_angular_velocity", options.search_angular_velocity, options.search_angular_velocity);
-  nh.param("scan_timeout", options.scan_timeout, options.scan_timeout);
-  nh.param("pose_timeout", options.pose_timeout, options.pose_timeout);
-  nh.param("map_timeout", options.map_timeout, options.map_timeout);
-  nh.param("obstacle_memory", options.obstacle_memory, options.obstacle_memory);
-  if (options.map_frame.empty() || options.base_frame.empty())
-    throw common::InputError("~map_frame, ~base_frame", "must not be empty");
-  if (!std::isfinite(options.control_rate) || options.control_rate <= 0.0)
-    throw common::InputError("~control_rate", "must be positive");
-  for (const auto& [name, value] : {std::pair<const char*, double>{"replan_interval", options.replan_interval},
-                                    {"goal_hysteresis", options.goal_hysteresis},
-                                    {"blacklist_radius", options.blacklist_radius},
-                                    {"map_timeout", options.map_timeout},
-                                    {"obstacle_memory", options.obstacle_memory}})
-    if (!std::isfinite(value) || value < 0.0)
-      throw common::InputError(std::string("~") + name, "must be zero or positive");
-  for (const auto& [name, value] : {std::pair<const char*, double>{"scan_timeout", options.scan_timeout},
-                                    {"pose_timeout", options.pose_timeout}})
-    if (!std::isfinite(value) || value <= 0.0) throw common::InputError(std::string("~") + name, "must be positive");
-  if (!std::isfinite(options.search_angular_velocity))
-    throw common::InputError("~search_angular_velocity", "must be finite");
-  if (options.done_confirmations < 1) throw common::InputError("~done_confirmations", "must be at least 1");
+  readParameters(nh, exploration::gridPlannerOptionTable(), &options.planner);
+  exploration::validate(options.planner);  // the rules between parameters
+  options.frontiers.free_threshold = options.planner.free_threshold;
+  options.frontiers.occupied_threshold = options.planner.occupied_threshold;
+  readParameters(nh, exploration::frontierOptionTable(), &options.frontiers);
+  readParameters(nh, exploration::pathFollowerOptionTable(), &options.follower);
+  readParameters(nh, exploration::blockedPassagesOptionTable(), &options.passages);
+  exploration::validate(options.passages);
+  readParameters(nh, exploration::explorationPolicyOptionTable(),
+                 static_cast<exploration::ExplorationPolicyOptions*>(&options));
+  readParameters(nh, explorerNodeOptionTable(), &options);
   return options;
 }
 

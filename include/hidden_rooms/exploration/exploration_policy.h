@@ -7,6 +7,7 @@
 
 #include "hidden_rooms/common/geometry.h"
 #include "hidden_rooms/common/occupancy_grid.h"
+#include "hidden_rooms/common/options.h"
 #include "hidden_rooms/common/velocity_command.h"
 #include "hidden_rooms/exploration/frontier.h"
 #include "hidden_rooms/exploration/grid_planner.h"
@@ -27,6 +28,9 @@ struct ExplorationPolicyOptions {
   double search_angular_velocity = 0.4;  // rad/s turned in place while there is no goal (and not done)
   double obstacle_memory = 1.5;     // seconds laser points are remembered (for the robot's blind rear)
 };
+
+// The explorer's parameters of the policy itself (docs/ros_api.md); the nested options have tables of their own.
+const common::OptionTable<ExplorationPolicyOptions>& explorationPolicyOptionTable();
 
 // Something the policy did or found, for the log; in the order it happened.
 enum class ExplorationEventType {

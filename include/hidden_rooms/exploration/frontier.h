@@ -8,6 +8,7 @@
 
 #include "hidden_rooms/common/geometry.h"
 #include "hidden_rooms/common/occupancy_grid.h"
+#include "hidden_rooms/common/options.h"
 #include "hidden_rooms/exploration/grid_planner.h"
 
 namespace hidden_rooms::exploration {
@@ -85,6 +86,10 @@ struct BlockedPassagesOptions {
 
 // Throws InputError("explorer options", ...) naming a negative, non-finite or inconsistent option.
 void validate(const BlockedPassagesOptions& options);
+// The explorer's parameters of the frontiers and of the blocked passages (docs/ros_api.md); the thresholds of free
+// and occupied cells are the planner's.
+const common::OptionTable<FrontierOptions>& frontierOptionTable();
+const common::OptionTable<BlockedPassagesOptions>& blockedPassagesOptionTable();
 
 class BlockedPassages {
  public:

@@ -6,6 +6,7 @@
 
 #include "hidden_rooms/common/geometry.h"
 #include "hidden_rooms/common/occupancy_grid.h"
+#include "hidden_rooms/common/options.h"
 
 namespace hidden_rooms::exploration {
 
@@ -27,6 +28,8 @@ struct GridPlannerOptions {
 
 // Throws InputError("explorer options", ...) naming a non-finite, negative or inconsistent option.
 void validate(const GridPlannerOptions& options);
+// The explorer's parameters of the planner (docs/ros_api.md).
+const common::OptionTable<GridPlannerOptions>& gridPlannerOptionTable();
 
 // Wavefront (Dijkstra) planner on an occupancy grid. Obstacles (value >= occupied_threshold) are inflated by
 // min_clearance with a distance transform; the robot's centre may stand on free cells outside the inflation

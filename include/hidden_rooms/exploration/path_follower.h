@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "hidden_rooms/common/geometry.h"
+#include "hidden_rooms/common/options.h"
 #include "hidden_rooms/common/range_scan.h"
 #include "hidden_rooms/common/velocity_command.h"
 
@@ -56,6 +57,8 @@ struct PathFollowerOptions {
 
 // Throws InputError("explorer options", ...) naming a non-finite, negative or inconsistent option.
 void validate(const PathFollowerOptions& options);
+// The explorer's parameters of the follower (docs/ros_api.md).
+const common::OptionTable<PathFollowerOptions>& pathFollowerOptionTable();
 
 enum class FollowerState { kIdle, kFollowing, kBackingOff, kRecoveryRotating, kGoalReached, kFailed };
 const char* toString(FollowerState state);

@@ -26,7 +26,11 @@ struct ExplorerOptions : exploration::ExplorationPolicyOptions {
   double map_timeout = 10.0;        // seconds (ROS time) without a new map (mapper down) stop the robot; 0 = never
 };
 
-// Reads the options from the private node handle. Throws InputError for a bad value.
+// The node's own parameters (frames, rates, timeouts); the policy's are in the core's tables.
+const common::OptionTable<ExplorerOptions>& explorerNodeOptionTable();
+// Every parameter of the node, as docs/ros_api.md lists them.
+std::vector<common::OptionDescription> explorerParameters();
+// Reads the options from the private node handle. Throws InputError naming the first bad parameter.
 ExplorerOptions readExplorerOptions(const ros::NodeHandle& private_nh);
 
 // Nearest-frontier exploration (replaces explore + move_base) with the core's ExplorationPolicy on the latest

@@ -1,0 +1,99 @@
+// docs/ros_api.md against the nodes' option tables: every parameter of a table is documented in its node's
+// section with the table's type and default, and every parameter the section documents is in a table.
+
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "hidden_rooms/ros/explorer.h"
+
+namespace hidden_rooms {
+namespace {
+
+struct DocumentedParameter {
+  std::string type;
+  std::string default_value;
+};
+
+std::string trimmed(const std::string& text) {
+  const size_t begin = text.find_first_not_of(" `\"");
+  const size_t end = text.find_last_not_of(" `\"");
+  return begin == std::string::npos ? "" : text.substr(begin, end - begin + 1);
+}
+
+std::vector<std::string> split(const std::string& text, const std::string& separator) {
+  std::vector<std::string> parts;
+  size_t start = 0;
+  for (size_t at = text.find(separator); at != std::string::npos; at = text.find(separator, start)) {
+    parts.push_back(text.substr(start, at - start));
+    start = at + separator.size();
+  }
+  parts.push_back(text.substr(start));
+  return parts;
+}
+
+// The rows "| `~a`, `~b` | type | default_a, default_b | meaning |" of the section "## `node`".
+std::map<std::string, DocumentedParameter> documentedParameters(const std::string& node) {
+  std::ifstream file(std::string(HIDDEN_ROOMS_SOURCE_DIR) + "/docs/ros_api.md");
+  std::map<std::string, DocumentedParameter> parameters;
+  std::string line;
+  bool in_section = false;
+  while (std::getline(file, line)) {
+    if (line.rfind("## ", 0) == 0) in_section = line == "## `" + node + "`";
+    if (!in_section || line.rfind("| `~", 0) != 0) continue;
+    const std::vector<std::string> columns = split(line.substr(1), " | ");
+    if (columns.size() < 3) continue;
+    std::vector<std::string> names;
+    const std::regex name_pattern("`~(\\w+)`");
+    for (std::sregex_iterator it(columns[0].begin(), columns[0].end(), name_pattern), end; it != end; ++it)
+      names.push_back((*it)[1]);
+    const std::vector<std::string> defaults = split(columns[2], ", ");
+    for (size_t k = 0; k < names.size(); ++k)
+      parameters[names[k]] = {trimmed(columns[1]), trimmed(defaults.size() == names.size() ? defaults[k] : "?")};
+  }
+  return parameters;
+}
+
+// Numbers compare by value (0.30 and 0.3 are the same default), anything else as text.
+bool sameDefault(const std::string& documented, const std::string& actual) {
+  char* end = nullptr;
+  const double a = std::strtod(documented.c_str(), &end);
+  if (end != documented.c_str() && *end == '\0') {
+    const double b = std::strtod(actual.c_str(), &end);
+    return *end == '\0' && a == b;
+  }
+  return documented == trimmed(actual);
+}
+
+void expectDocumented(const std::string& node, const std::vector<common::OptionDescription>& table) {
+  const std::map<std::string, DocumentedParameter> documented = documentedParameters(node);
+  ASSERT_FALSE(documented.empty()) << "no parameter rows in the section of " << node;
+  std::map<std::string, bool> in_table;
+  for (const common::OptionDescription& row : table) {
+    in_table[row.name] = true;
+    const auto found = documented.find(row.name);
+    if (found == documented.end()) {
+      ADD_FAILURE() << node << ": ~" << row.name << " is not in docs/ros_api.md";
+      continue;
+    }
+    EXPECT_EQ(found->second.type, row.type) << node << ": type of ~" << row.name;
+    EXPECT_TRUE(sameDefault(found->second.default_value, row.default_value))
+        << node << ": ~" << row.name << " defaults to " << row.default_value << ", the docs say "
+        << found->second.default_value;
+  }
+  for (const auto& [name, parameter] : documented)
+    EXPECT_TRUE(in_table.count(name)) << node << ": docs/ros_api.md documents ~" << name << ", which it does not read";
+}
+
+TEST(ParameterDocs, ExplorerParametersAreDocumentedWithTheirTypesAndDefaults) {
+  expectDocumented("explorer", explorerParameters());
+}
+
+}  // namespace
+}  // namespace hidden_rooms
