@@ -17,19 +17,6 @@ namespace hidden_rooms::prediction {
 
 namespace {
 
-// Defaults (documented in config/prediction.yaml).
-constexpr double kStartSearchRadius = 1.0;   // m (shared with the baselines)
-constexpr double kWallGap = 1.5;             // m: longest gap in the door's wall still followed
-constexpr double kMaxExtent = 25.0;          // m: longest lateral extent and depth searched
-constexpr double kBoundedFraction = 0.5;     // share of columns ending on a known pixel for a measured depth
-constexpr double kNeighbourReach = 15.0;     // m: how far along the wall explored neighbours are looked for
-constexpr double kMinDepth = 2.0;            // m: smallest depth taken from the square prior
-constexpr double kMinRotation = 1.0;         // degrees: smaller dominant angles are not corrected
-constexpr double kGrownAreaRatio = 1.25;     // grown rooms less than this many times the rectangle give way
-constexpr double kStubLength = 0.3;          // m: wall stubs this long into the explored side end a room's extent
-constexpr double kOutlineReach = 15.0;       // m: band beside a room within which the known map's extent bounds it
-constexpr double kWallMargin = -1.0;         // m: unseen wall thickness left out of rooms; < 0: estimated from the map
-
 // Working states of a pixel; map values at or above kOccupiedFrom are walls.
 constexpr uint8_t kUnknownPx = 0, kFreePx = 1, kOccupiedPx = 2;
 constexpr int8_t kOccupiedFrom = 50;
@@ -41,11 +28,6 @@ cv::Mat1b statesOf(const common::OccupancyGrid& map) {
   states.setTo(kOccupiedPx, map.cells >= kOccupiedFrom);
   return states;
 }
-
-struct Parameters {
-  double start_search_radius, wall_gap, max_extent, bounded_fraction, neighbour_reach, min_depth, min_rotation;
-  double grown_area_ratio, stub_length, outline_reach, wall_margin;
-};
 
 // A door in the working image: centre pixel, wall axis a and normal n (unit axis vectors, n into the unknown).
 struct DoorFrame {
@@ -138,7 +120,7 @@ double unknownBehind(const Frame& f, DoorFrame d, int depth) {
 }
 
 // Side, wall rows and first unknown row of a door.
-void placeDoor(const Frame& f, double resolution, const Parameters& P, DoorFrame* d) {
+void placeDoor(const Frame& f, double resolution, const DefaultOptions& P, DoorFrame* d) {
   const int reach = std::max(2, static_cast<int>(std::lround(P.start_search_radius / resolution)));
   const cv::Point n0 = d->n;
   const double plus = unknownBehind(f, *d, reach);
@@ -203,7 +185,7 @@ bool isWallStep(const Frame& f, const DoorFrame& d, int u_after, int step, int v
 }
 
 // How far the room reaches along the wall in direction `sign`.
-int lateralExtent(const Frame& f, double resolution, const Parameters& P, DoorFrame* d, int sign) {
+int lateralExtent(const Frame& f, double resolution, const DefaultOptions& P, DoorFrame* d, int sign) {
   const int max_u = static_cast<int>(P.max_extent / resolution);
   const int gap_limit = std::max(1, static_cast<int>(P.wall_gap / resolution));
   const int probe1 = std::max(2, static_cast<int>(0.4 / resolution));
@@ -256,7 +238,7 @@ int lateralExtent(const Frame& f, double resolution, const Parameters& P, DoorFr
 }
 
 // Per column of the extent, the unknown run behind the wall; sets depth when enough columns end on known space.
-void measureDepth(const Frame& f, double resolution, const Parameters& P, DoorFrame* d) {
+void measureDepth(const Frame& f, double resolution, const DefaultOptions& P, DoorFrame* d) {
   const int max_v = static_cast<int>(P.max_extent / resolution);
   const int width = d->right - d->left + 1;
   const int margin = width / 10;
@@ -283,7 +265,7 @@ void measureDepth(const Frame& f, double resolution, const Parameters& P, DoorFr
 }
 
 // Depth of explored rooms on the same side of the same wall, within reach of the door's extent.
-double neighbourDepth(const Frame& f, double resolution, const Parameters& P, const DoorFrame& d) {
+double neighbourDepth(const Frame& f, double resolution, const DefaultOptions& P, const DoorFrame& d) {
   const int reach = static_cast<int>(P.neighbour_reach / resolution);
   const int max_v = static_cast<int>(P.max_extent / resolution);
   const int entry = std::max(2, static_cast<int>(0.5 / resolution));
@@ -429,14 +411,37 @@ double dominantWallAngle(const common::OccupancyGrid& map) {
 
 double unseenWallThickness(const common::OccupancyGrid& map) { return unseenWallMetres(statesOf(map), map.resolution); }
 
+const common::OptionTable<DefaultOptions>& defaultOptionTable() {
+  using O = DefaultOptions;
+  static const common::OptionTable<O> table{
+      {"start_search_radius", &O::start_search_radius, "m: a door's nearest unknown cell lies within this",
+       common::above(0)},
+      {"default_wall_gap", &O::wall_gap, "m: longest gap in the door's wall still followed", common::atLeast(0)},
+      {"default_max_extent", &O::max_extent, "m: longest lateral extent and depth searched", common::above(0)},
+      {"default_bounded_fraction", &O::bounded_fraction,
+       "share of columns ending on a known pixel for a measured depth", common::between(0, 1)},
+      {"default_neighbour_reach", &O::neighbour_reach,
+       "m: how far along the wall explored neighbours are looked for", common::atLeast(0)},
+      {"default_min_depth", &O::min_depth, "m: smallest depth taken from the square prior", common::atLeast(0)},
+      {"default_min_rotation", &O::min_rotation, "degrees: smaller dominant angles are not corrected",
+       common::atLeast(0)},
+      {"default_grown_area_ratio", &O::grown_area_ratio,
+       "grown rooms less than this many times the rectangle give way", common::atLeast(0)},
+      {"default_stub_length", &O::stub_length, "m: wall stubs this long into the explored side end an extent",
+       common::atLeast(0)},
+      {"default_outline_reach", &O::outline_reach,
+       "m: band beside a room within which the known map's extent bounds it", common::atLeast(0)},
+      {"default_wall_margin", &O::wall_margin,
+       "m: unseen wall thickness left out of rooms; < 0: estimated from the map",
+       {-std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(), false, false}},
+  };
+  return table;
+}
+
 std::map<std::string, double> DefaultPredictor::defaultParameters() const {
   std::map<std::string, double> parameters = layoutParameters(LayoutOptions());  // for the grown rooms
-  parameters.insert({{"start_search_radius", kStartSearchRadius}, {"default_wall_gap", kWallGap},
-                     {"default_max_extent", kMaxExtent},          {"default_bounded_fraction", kBoundedFraction},
-                     {"default_neighbour_reach", kNeighbourReach}, {"default_min_depth", kMinDepth},
-                     {"default_min_rotation", kMinRotation},       {"default_grown_area_ratio", kGrownAreaRatio},
-                     {"default_stub_length", kStubLength},         {"default_outline_reach", kOutlineReach},
-                     {"default_wall_margin", kWallMargin}});
+  const std::map<std::string, double> own = common::optionValues(defaultOptionTable(), DefaultOptions());
+  parameters.insert(own.begin(), own.end());
   return parameters;
 }
 
@@ -451,7 +456,7 @@ struct WorkingImage {
 
 // Step 1, orientation: the map's states turned by -angle about their centre, on an image large enough for the
 // whole turned map (plus one pixel each side), when |angle| is at least min_rotation; else the states as they are.
-WorkingImage orientedStates(const cv::Mat1b& map_states, double angle, const Parameters& P) {
+WorkingImage orientedStates(const cv::Mat1b& map_states, double angle, const DefaultOptions& P) {
   WorkingImage work;
   work.rotated = std::abs(angle) * 180.0 / CV_PI >= P.min_rotation;
   work.states = map_states;
@@ -472,7 +477,7 @@ WorkingImage orientedStates(const cv::Mat1b& map_states, double angle, const Par
 
 // Step 2, extent: every door of the request in the working frame, placed on its wall (placeDoor) with its lateral
 // extent (lateralExtent); a door that cannot be placed keeps ok = false and its problem.
-std::vector<DoorFrame> framedDoors(const PredictionRequest& request, const Parameters& P, const WorkingImage& work,
+std::vector<DoorFrame> framedDoors(const PredictionRequest& request, const DefaultOptions& P, const WorkingImage& work,
                                    const Frame& f) {
   const common::OccupancyGrid& map = request.map;
   const double resolution = map.resolution;
@@ -528,7 +533,7 @@ std::vector<std::vector<int>> splitSharedExtents(double resolution, std::vector<
 
 // Step 2, depth: every placed door's depth, measured (measureDepth), else from the explored neighbours
 // (neighbourDepth), else the median of its bounded siblings, else the square prior; depth_source tells which.
-void measureDepths(const Frame& f, double resolution, const Parameters& P,
+void measureDepths(const Frame& f, double resolution, const DefaultOptions& P,
                    const std::vector<std::vector<int>>& siblings, std::vector<DoorFrame>* doors) {
   for (DoorFrame& d : *doors)
     if (d.ok) measureDepth(f, resolution, P, &d);
@@ -711,7 +716,7 @@ std::vector<RoomPrediction> mapFrameRooms(const PredictionRequest& request, cons
 
 // The wall-fitted rectangle of every door (steps 1 to 3 of the header), in the map's frame; `angle` is the map's
 // dominantWallAngle, `map_states` its statesOf and `map_known` its known cells (255).
-std::vector<RoomPrediction> rectangleRooms(const PredictionRequest& request, const Parameters& P, double angle,
+std::vector<RoomPrediction> rectangleRooms(const PredictionRequest& request, const DefaultOptions& P, double angle,
                                            const cv::Mat1b& map_states, const cv::Mat1b& map_known) {
   const double resolution = request.map.resolution;
   const WorkingImage work = orientedStates(map_states, angle, P);
@@ -731,16 +736,9 @@ PredictionResult DefaultPredictor::predict(const PredictionRequest& request) con
   const auto start_time = std::chrono::steady_clock::now();
   checkUsableMap(request.map);
   const auto values = resolveParameters(*this, request.parameters);
-  const Parameters P{values.at("start_search_radius"),     values.at("default_wall_gap"),
-                     values.at("default_max_extent"),      values.at("default_bounded_fraction"),
-                     values.at("default_neighbour_reach"), values.at("default_min_depth"),
-                     values.at("default_min_rotation"),    values.at("default_grown_area_ratio"),
-                     values.at("default_stub_length"),     values.at("default_outline_reach"),
-                     values.at("default_wall_margin")};
-  if (P.start_search_radius <= 0.0 || P.wall_gap < 0.0 || P.max_extent <= 0.0 || P.neighbour_reach < 0.0 ||
-      P.min_depth < 0.0 || P.min_rotation < 0.0 || P.bounded_fraction < 0.0 || P.bounded_fraction > 1.0 ||
-      P.grown_area_ratio < 0.0 || P.stub_length < 0.0 || P.outline_reach < 0.0 || std::isnan(P.wall_margin))
-    throw common::InputError("parameters", "default_* parameters out of range");
+  DefaultOptions P;
+  common::applyOptionValues(defaultOptionTable(), values, &P, "parameter ");
+  common::validateOptions(defaultOptionTable(), P, "parameter ");
 
   // The grown rooms: the thesis's growth with its own constants on the layout this request configures. It does
   // not depend on the rectangles, so it runs on a second thread meanwhile.

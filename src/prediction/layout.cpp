@@ -7,7 +7,6 @@
 #include <opencv2/imgproc.hpp>
 
 #include "hidden_rooms/common/input_error.h"
-#include "hidden_rooms/common/parameter_table.h"
 #include "hidden_rooms/prediction/layout_debug.h"
 
 namespace hidden_rooms::prediction {
@@ -15,50 +14,58 @@ namespace hidden_rooms::prediction {
 // ---------------------------------------------------------------------------------------------------------
 // Options
 
-namespace {
-
-using ParameterField = hidden_rooms::common::ParameterField<LayoutOptions>;
-
-// config/layout.yaml's order.
-const std::vector<ParameterField>& parameterFields() {
-  static const std::vector<ParameterField> fields{
-      {"binary_threshold", &LayoutOptions::binary_threshold},
-      {"canny_low_threshold", &LayoutOptions::canny_low_threshold},
-      {"canny_high_threshold", &LayoutOptions::canny_high_threshold},
-      {"canny_aperture", &LayoutOptions::canny_aperture},
-      {"hough_rho", &LayoutOptions::hough_rho},
-      {"hough_theta", &LayoutOptions::hough_theta},
-      {"hough_threshold", &LayoutOptions::hough_threshold},
-      {"hough_min_line_length", &LayoutOptions::hough_min_line_length},
-      {"hough_max_line_gap", &LayoutOptions::hough_max_line_gap},
-      {"angular_bandwidth", &LayoutOptions::angular_bandwidth},
-      {"wall_cluster_distance", &LayoutOptions::wall_cluster_distance},
-      {"line_merge_distance", &LayoutOptions::line_merge_distance},
-      {"door_pair_lines", &LayoutOptions::door_pair_lines},
-      {"boundary_offset", &LayoutOptions::boundary_offset},
-      {"out_unknown_fraction", &LayoutOptions::out_unknown_fraction},
-      {"wall_coverage_band", &LayoutOptions::wall_coverage_band},
-      {"affinity_sigma", &LayoutOptions::affinity_sigma},
-      {"dbscan_eps", &LayoutOptions::dbscan_eps},
-      {"dbscan_min_points", &LayoutOptions::dbscan_min_points},
-      {"door_search_radius", &LayoutOptions::door_search_radius},
+const common::OptionTable<LayoutOptions>& layoutOptionTable() {
+  using O = LayoutOptions;
+  static const common::OptionTable<O> table{
+      {"binary_threshold", &O::binary_threshold,
+       "grey level: darker pixels (walls) become black before Canny", common::between(0, 255)},
+      {"canny_low_threshold", &O::canny_low_threshold,
+       "Canny hysteresis: lower threshold (gradient magnitude)", common::atLeast(0)},
+      {"canny_high_threshold", &O::canny_high_threshold, "Canny hysteresis: upper threshold", common::atLeast(0)},
+      {"canny_aperture", &O::canny_aperture, "Sobel aperture of Canny: 3, 5 or 7", common::between(3, 7)},
+      {"hough_rho", &O::hough_rho, "pixels: distance step of the Hough accumulator", common::above(0)},
+      {"hough_theta", &O::hough_theta, "rad: angle step of the Hough accumulator", {0, CV_PI, true, true}},
+      {"hough_threshold", &O::hough_threshold,
+       "m: accumulator votes, as edge length (20 votes at 0.05 m)", common::above(0)},
+      {"hough_min_line_length", &O::hough_min_line_length,
+       "m: shortest segment kept (7 px at 0.05 m)", common::atLeast(0)},
+      {"hough_max_line_gap", &O::hough_max_line_gap,
+       "m: largest gap bridged inside a segment (3 px)", common::atLeast(0)},
+      {"angular_bandwidth", &O::angular_bandwidth,
+       "rad: mean-shift bandwidth of the angular clustering", {0, CV_PI / 2, true, true}},
+      {"wall_cluster_distance", &O::wall_cluster_distance,
+       "m: largest lateral spread of one wall's segments (10 px)", common::atLeast(0)},
+      {"line_merge_distance", &O::line_merge_distance,
+       "m: extended lines this close become one (no sliver cells)", common::atLeast(0)},
+      {"door_pair_lines", &O::door_pair_lines, "add Algorithm 1's lines between pairs of closed doors"},
+      {"boundary_offset", &O::boundary_offset,
+       "m: boundary lines outside the segments' bounding box (20 px)", common::above(0)},
+      {"out_unknown_fraction", &O::out_unknown_fraction,
+       "a cell with a larger fraction of unknown pixels is OUT", common::between(0, 1)},
+      {"wall_coverage_band", &O::wall_coverage_band,
+       "m: occupied pixels this close to an edge cover it", common::atLeast(0)},
+      {"affinity_sigma", &O::affinity_sigma,
+       "affinity of adjacent cells = exp(-wall fraction / sigma)", common::above(0)},
+      {"dbscan_eps", &O::dbscan_eps, "DBSCAN radius on the distance 1 - affinity, in (0, 1)", {0, 1, true, true}},
+      {"dbscan_min_points", &O::dbscan_min_points,
+       "DBSCAN core-point size (the cell itself counts)", common::atLeast(1)},
+      {"door_search_radius", &O::door_search_radius,
+       "m: a door's IN/OUT cell edge must be this close", common::above(0)},
   };
-  return fields;
+  return table;
 }
 
-}  // namespace
-
 const std::vector<std::string>& layoutParameterNames() {
-  static const std::vector<std::string> names = common::parameterNames(parameterFields());
+  static const std::vector<std::string> names = common::optionNames(layoutOptionTable());
   return names;
 }
 
 std::map<std::string, double> layoutParameters(const LayoutOptions& options) {
-  return common::parameterValues(parameterFields(), options);
+  return common::optionValues(layoutOptionTable(), options);
 }
 
 void applyLayoutParameters(const std::map<std::string, double>& parameters, LayoutOptions* options) {
-  common::applyParameterValues(parameterFields(), parameters, options);
+  common::applyOptionValues(layoutOptionTable(), parameters, options, "parameter ");
   validateLayoutOptions(*options);
 }
 
@@ -73,32 +80,9 @@ LayoutOptions layoutOptionsFromParameters(const std::map<std::string, double>& p
 }
 
 void validateLayoutOptions(const LayoutOptions& o) {
-  constexpr double kInf = std::numeric_limits<double>::infinity();
-  common::requireFiniteParameters(parameterFields(), o);
-  common::requireParameterInRange("binary_threshold", o.binary_threshold, {0, 255, false, false});
-  common::requireParameterInRange("canny_low_threshold", o.canny_low_threshold, {0, kInf, false, true});
-  common::requireParameterInRange("canny_high_threshold", o.canny_high_threshold, {0, kInf, false, true});
+  common::validateOptions(layoutOptionTable(), o, "parameter ");
   if (o.canny_aperture != 3 && o.canny_aperture != 5 && o.canny_aperture != 7)
-    throw common::InputError(
-        "parameters", "parameter 'canny_aperture' must be 3, 5 or 7, got " + common::formatNumber(o.canny_aperture));
-  common::requireParameterInRange("hough_rho", o.hough_rho, {0, kInf, true, true});
-  common::requireParameterInRange("hough_theta", o.hough_theta, {0, CV_PI, true, true});
-  common::requireParameterInRange("hough_threshold", o.hough_threshold, {0, kInf, true, true});
-  common::requireParameterInRange("hough_min_line_length", o.hough_min_line_length, {0, kInf, false, true});
-  common::requireParameterInRange("hough_max_line_gap", o.hough_max_line_gap, {0, kInf, false, true});
-  common::requireParameterInRange("angular_bandwidth", o.angular_bandwidth, {0, CV_PI / 2, true, true});
-  common::requireParameterInRange("wall_cluster_distance", o.wall_cluster_distance, {0, kInf, false, true});
-  common::requireParameterInRange("line_merge_distance", o.line_merge_distance, {0, kInf, false, true});
-  if (o.door_pair_lines != 0 && o.door_pair_lines != 1)
-    throw common::InputError(
-        "parameters", "parameter 'door_pair_lines' must be 0 or 1, got " + common::formatNumber(o.door_pair_lines));
-  common::requireParameterInRange("boundary_offset", o.boundary_offset, {0, kInf, true, true});
-  common::requireParameterInRange("out_unknown_fraction", o.out_unknown_fraction, {0, 1, false, false});
-  common::requireParameterInRange("wall_coverage_band", o.wall_coverage_band, {0, kInf, false, true});
-  common::requireParameterInRange("affinity_sigma", o.affinity_sigma, {0, kInf, true, true});
-  common::requireParameterInRange("dbscan_eps", o.dbscan_eps, {0, 1, true, true});
-  common::requireParameterInRange("dbscan_min_points", o.dbscan_min_points, {1, kInf, false, true, true});
-  common::requireParameterInRange("door_search_radius", o.door_search_radius, {0, kInf, true, true});
+    throw common::InputError("parameter canny_aperture", "must be 3, 5 or 7, got " + std::to_string(o.canny_aperture));
 }
 
 // ---------------------------------------------------------------------------------------------------------

@@ -91,7 +91,7 @@ ThesisTerms thesisTerms(const CellGrid& grid, const std::vector<int>& cells, con
   for (int c : cells) in_room[c] = 1;
   auto is_free = [&](int c) {
     return grid.cells[c].out && !in_room[c] && (taken.empty() || !taken[c]) &&
-           (options.border_cells_free != 0.0 || !grid.cells[c].border);
+           (options.border_cells_free || !grid.cells[c].border);
   };
   std::vector<cv::Point> points, hull;
   cv::Rect box = grid.cells[cells.front()].rect;
@@ -195,7 +195,7 @@ bool ThesisExpansion::isDependent(int r) const {
 }
 
 bool ThesisExpansion::isFree(int c) const {
-  return grid_.cells[c].out && owner_[c] < 0 && (options_.border_cells_free != 0.0 || !grid_.cells[c].border);
+  return grid_.cells[c].out && owner_[c] < 0 && (options_.border_cells_free || !grid_.cells[c].border);
 }
 
 bool ThesisExpansion::adjacent(int a, int b) const {

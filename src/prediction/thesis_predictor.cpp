@@ -10,7 +10,6 @@
 
 #include "hidden_rooms/common/image_io.h"
 #include "hidden_rooms/common/input_error.h"
-#include "hidden_rooms/common/parameter_table.h"
 #include "hidden_rooms/prediction/prediction_support.h"
 #include "hidden_rooms/prediction/structured_predictor.h"
 #include "hidden_rooms/prediction/thesis_expansion.h"
@@ -19,47 +18,7 @@ namespace hidden_rooms::prediction {
 
 namespace {
 
-using ParameterField = hidden_rooms::common::ParameterField<ThesisOptions>;
-
-const std::vector<ParameterField>& parameterFields() {
-  static const std::vector<ParameterField> fields{
-      {"thesis_ind_k1", &ThesisOptions::ind_k1},
-      {"thesis_ind_k2", &ThesisOptions::ind_k2},
-      {"thesis_ind_k3", &ThesisOptions::ind_k3},
-      {"thesis_ind_k4", &ThesisOptions::ind_k4},
-      {"thesis_dep_k1", &ThesisOptions::dep_k1},
-      {"thesis_dep_k2", &ThesisOptions::dep_k2},
-      {"thesis_dep_k3", &ThesisOptions::dep_k3},
-      {"thesis_dep_k4", &ThesisOptions::dep_k4},
-      {"thesis_dep_k5", &ThesisOptions::dep_k5},
-      {"thesis_dep_cv", &ThesisOptions::dep_cv},
-      {"thesis_proportion_threshold", &ThesisOptions::proportion_threshold},
-      {"thesis_outcast_min_neighbours", &ThesisOptions::outcast_min_neighbours},
-      {"thesis_depth", &ThesisOptions::depth},
-      {"thesis_max_candidates", &ThesisOptions::max_candidates},
-      {"thesis_fix_pairs", &ThesisOptions::fix_pairs},
-      {"thesis_fix_k1", &ThesisOptions::fix_k1},
-      {"thesis_fix_k2", &ThesisOptions::fix_k2},
-      {"thesis_max_exchangeable", &ThesisOptions::max_exchangeable},
-      {"thesis_border_rooms", &ThesisOptions::border_rooms},
-      {"thesis_border_cells_free", &ThesisOptions::border_cells_free},
-  };
-  return fields;
-}
-
-void validate(const ThesisOptions& o) {
-  common::requireFiniteParameters(parameterFields(), o);
-  common::requireParameterInRange("thesis_depth", o.depth, {0, 1000, false, false, true});
-  common::requireParameterInRange("thesis_max_candidates", o.max_candidates, {0, 20, false, false, true});
-  common::requireParameterInRange("thesis_max_exchangeable", o.max_exchangeable, {0, 20, false, false, true});
-  common::requireParameterInRange("thesis_fix_pairs", o.fix_pairs, {0, 1, false, false, true});
-  common::requireParameterInRange("thesis_border_rooms", o.border_rooms, {0, 1, false, false, true});
-  common::requireParameterInRange("thesis_border_cells_free", o.border_cells_free, {0, 1, false, false, true});
-  common::requireParameterInRange("thesis_outcast_min_neighbours", o.outcast_min_neighbours,
-                                  {1, 4, false, false, true});
-  if (o.proportion_threshold < 1.0)
-    throw common::InputError("parameters", "parameter 'thesis_proportion_threshold' must be at least 1");
-}
+void validate(const ThesisOptions& o) { common::validateOptions(thesisOptionTable(), o, "parameter "); }
 
 enum class Growth { kUp, kDown, kLeft, kRight };
 
@@ -153,18 +112,49 @@ cv::Mat1b borderRoomMask(const common::OccupancyGrid& map, const cv::Rect& squar
 
 // ---------------------------------------------------------------------------------------------------------
 
+const common::OptionTable<ThesisOptions>& thesisOptionTable() {
+  using O = ThesisOptions;
+  static const common::OptionTable<O> table{
+      {"thesis_ind_k1", &O::ind_k1, "independent room utility: weight of co"},
+      {"thesis_ind_k2", &O::ind_k2, "independent room utility: weight of fe"},
+      {"thesis_ind_k3", &O::ind_k3, "independent room utility: weight of oc"},
+      {"thesis_ind_k4", &O::ind_k4, "independent room utility: weight of sqrt(ar)"},
+      {"thesis_dep_k1", &O::dep_k1, "dependent room utility: weight of co"},
+      {"thesis_dep_k2", &O::dep_k2, "dependent room utility: weight of fe"},
+      {"thesis_dep_k3", &O::dep_k3, "dependent room utility: weight of oc - cv"},
+      {"thesis_dep_k4", &O::dep_k4, "dependent room utility: weight of sqrt(ar)"},
+      {"thesis_dep_k5", &O::dep_k5, "dependent room utility: weight of the proportion term"},
+      {"thesis_dep_cv", &O::dep_cv, "dependent room utility: outcasts tolerated"},
+      {"thesis_proportion_threshold", &O::proportion_threshold,
+       "pr = max(0, long side / short side - threshold)", common::atLeast(1)},
+      {"thesis_outcast_min_neighbours", &O::outcast_min_neighbours,
+       "a room cell with n >= this many free neighbours costs n - (this - 1)", common::between(1, 4)},
+      {"thesis_depth", &O::depth, "greedy expansion steps (level of depth l)", common::between(0, 1000)},
+      {"thesis_max_candidates", &O::max_candidates,
+       "candidates per expansion step (2^n subsets are scored)", common::between(0, 20)},
+      {"thesis_fix_pairs", &O::fix_pairs, "exchange cells between adjacent rooms (docs/method.md#pair-fix)"},
+      {"thesis_fix_k1", &O::fix_k1, "pair fix score: weight of sqrt(max area / min area)"},
+      {"thesis_fix_k2", &O::fix_k2, "pair fix score: weight of co_i + co_j"},
+      {"thesis_max_exchangeable", &O::max_exchangeable,
+       "exchangeable cells per pair (2^n assignments are scored)", common::between(0, 20)},
+      {"thesis_border_rooms", &O::border_rooms, "border-cell rooms grow into squares (docs/method.md#border-rooms)"},
+      {"thesis_border_cells_free", &O::border_cells_free, "OUT border cells count as free in fe and oc"},
+  };
+  return table;
+}
+
 const std::vector<std::string>& thesisParameterNames() {
-  static const std::vector<std::string> names = common::parameterNames(parameterFields());
+  static const std::vector<std::string> names = common::optionNames(thesisOptionTable());
   return names;
 }
 
 std::map<std::string, double> thesisParameters(const ThesisOptions& options) {
-  return common::parameterValues(parameterFields(), options);
+  return common::optionValues(thesisOptionTable(), options);
 }
 
 ThesisOptions thesisOptionsFromParameters(const std::map<std::string, double>& parameters) {
   ThesisOptions options;
-  common::applyParameterValues(parameterFields(), parameters, &options);
+  common::applyOptionValues(thesisOptionTable(), parameters, &options, "parameter ");
   validate(options);
   return options;
 }
@@ -188,7 +178,7 @@ std::vector<ThesisRoomCells> thesisRoomCells(const Layout& layout, const ThesisO
   }
 
   expansion.expand();
-  if (options.fix_pairs != 0.0) expansion.fixPairs();
+  if (options.fix_pairs) expansion.fixPairs();
 
   std::vector<ThesisRoom>& rooms = expansion.rooms();
   // Border rooms (docs/method.md#border-rooms): rooms whose start cell lies on the grid's border.
@@ -197,7 +187,7 @@ std::vector<ThesisRoomCells> thesisRoomCells(const Layout& layout, const ThesisO
     BorderSide side;
   };
   std::vector<Square> squares;
-  if (options.border_rooms != 0.0)
+  if (options.border_rooms)
     for (size_t r = 0; r < rooms.size(); ++r) {
       ThesisRoom& room = rooms[r];
       if (!grid.cells[room.start].border) continue;

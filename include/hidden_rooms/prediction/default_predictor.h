@@ -48,9 +48,28 @@
 #include <map>
 #include <string>
 
+#include "hidden_rooms/common/options.h"
 #include "hidden_rooms/prediction/room_predictor.h"
 
 namespace hidden_rooms::prediction {
+
+// The method's own parameters (config/prediction.yaml documents each one).
+struct DefaultOptions {
+  double start_search_radius = 1.0;  // m: a door's nearest unknown cell lies within this (as the baselines')
+  double wall_gap = 1.5;             // m: longest gap in the door's wall still followed
+  double max_extent = 25.0;          // m: longest lateral extent and depth searched
+  double bounded_fraction = 0.5;     // share of columns ending on a known pixel for a measured depth
+  double neighbour_reach = 15.0;     // m: how far along the wall explored neighbours are looked for
+  double min_depth = 2.0;            // m: smallest depth taken from the square prior
+  double min_rotation = 1.0;         // degrees: smaller dominant angles are not corrected
+  double grown_area_ratio = 1.25;    // grown rooms less than this many times the rectangle give way
+  double stub_length = 0.3;          // m: wall stubs this long into the explored side end a room's extent
+  double outline_reach = 15.0;       // m: band beside a room within which the known map's extent bounds it
+  double wall_margin = -1.0;         // m: unseen wall thickness left out of rooms; < 0: estimated from the map
+};
+
+// Every DefaultOptions field as a parameter (start_search_radius, default_wall_gap, ...) with its range.
+const common::OptionTable<DefaultOptions>& defaultOptionTable();
 
 class DefaultPredictor : public RoomPredictor {
  public:

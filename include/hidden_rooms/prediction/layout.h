@@ -18,6 +18,7 @@
 #include "hidden_rooms/common/doors_file.h"
 #include "hidden_rooms/common/geometry.h"
 #include "hidden_rooms/common/occupancy_grid.h"
+#include "hidden_rooms/common/options.h"
 
 namespace hidden_rooms::prediction {
 
@@ -28,7 +29,7 @@ struct LayoutOptions {
   double binary_threshold = 150.0;         // grey level: darker pixels (walls) become black before Canny
   double canny_low_threshold = 90.0;       // Canny hysteresis thresholds (gradient magnitude)
   double canny_high_threshold = 100.0;
-  double canny_aperture = 5.0;             // Sobel aperture of Canny: 3, 5 or 7
+  int canny_aperture = 5;                  // Sobel aperture of Canny: 3, 5 or 7
   double hough_rho = 1.0;                  // pixels: distance step of the Hough accumulator
   double hough_theta = CV_PI / 180.0;      // rad: angle step of the Hough accumulator
   double hough_threshold = 1.0;            // m: accumulator votes, as edge length (20 votes at 0.05 m)
@@ -37,16 +38,18 @@ struct LayoutOptions {
   double angular_bandwidth = 0.023;        // rad: mean-shift bandwidth of the angular clustering
   double wall_cluster_distance = 0.5;      // m: largest lateral spread of one wall's segments (10 px)
   double line_merge_distance = 0.25;       // m: extended lines this close become one (no sliver cells)
-  double door_pair_lines = 1.0;            // 1: add Algorithm 1's lines between pairs of closed doors; 0: not
+  bool door_pair_lines = true;             // add Algorithm 1's lines between pairs of closed doors
   double boundary_offset = 1.0;            // m: boundary lines outside the segments' bounding box (20 px)
   double out_unknown_fraction = 0.8;       // a cell with a larger fraction of unknown pixels is OUT
   double wall_coverage_band = 0.25;        // m: occupied pixels this close to an edge cover it
   double affinity_sigma = 0.1;             // affinity of adjacent cells = exp(-wall fraction / sigma)
   double dbscan_eps = 0.85;                // DBSCAN radius on the distance 1 - affinity, in (0, 1)
-  double dbscan_min_points = 1.0;          // DBSCAN core-point size (the cell itself counts)
+  int dbscan_min_points = 1;               // DBSCAN core-point size (the cell itself counts)
   double door_search_radius = 2.0;         // m: a door's IN/OUT cell edge must be this close
 };
 
+// The analysis's parameters: every LayoutOptions field by name with its range, in config/layout.yaml's order.
+const common::OptionTable<LayoutOptions>& layoutOptionTable();
 // Names of every LayoutOptions field, in config/layout.yaml's order.
 const std::vector<std::string>& layoutParameterNames();
 // The options as a name -> value map (keys = layoutParameterNames()).

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "hidden_rooms/common/options.h"
 #include "hidden_rooms/prediction/layout.h"
 #include "hidden_rooms/prediction/room_predictor.h"
 
@@ -27,17 +28,19 @@ struct ThesisOptions {
   double dep_k5 = 2.0;
   double dep_cv = 1.0;
   double proportion_threshold = 2.0;   // pr = max(0, long side / short side - threshold)
-  double outcast_min_neighbours = 2.0; // a room cell with n >= this many free neighbours costs n - (this - 1)
-  double depth = 7.0;                  // greedy expansion steps (level of depth l)
-  double max_candidates = 12.0;        // candidates per expansion step (2^n subsets are scored)
-  double fix_pairs = 1.0;              // 1: exchange cells between adjacent rooms (docs/method.md#pair-fix); 0: not
+  int outcast_min_neighbours = 2;      // a room cell with n >= this many free neighbours costs n - (this - 1)
+  int depth = 7;                       // greedy expansion steps (level of depth l)
+  int max_candidates = 12;             // candidates per expansion step (2^n subsets are scored)
+  bool fix_pairs = true;               // exchange cells between adjacent rooms (docs/method.md#pair-fix)
   double fix_k1 = 1.0;                 // pair score: -k1 sqrt(max area / min area) - k2 (co_i + co_j)
   double fix_k2 = 1.0;
-  double max_exchangeable = 12.0;      // exchangeable cells per pair (2^n assignments are scored)
-  double border_rooms = 1.0;           // 1: border-cell rooms grow into squares (docs/method.md#border-rooms); 0: not
-  double border_cells_free = 0.0;      // 1: OUT border cells count as free in fe and oc; 0: they do not
+  int max_exchangeable = 12;           // exchangeable cells per pair (2^n assignments are scored)
+  bool border_rooms = true;            // border-cell rooms grow into squares (docs/method.md#border-rooms)
+  bool border_cells_free = false;      // OUT border cells count as free in fe and oc
 };
 
+// Every ThesisOptions field as a parameter ("thesis_ind_k1", ...) with its range, in config/prediction.yaml's order.
+const common::OptionTable<ThesisOptions>& thesisOptionTable();
 // Names of every ThesisOptions field as parameters ("thesis_ind_k1", ...), in config/prediction.yaml's order.
 const std::vector<std::string>& thesisParameterNames();
 std::map<std::string, double> thesisParameters(const ThesisOptions& options);
