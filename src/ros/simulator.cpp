@@ -3,6 +3,7 @@
 #include <cmath>
 #include <thread>
 
+#include <XmlRpcValue.h>
 #include <geometry_msgs/PolygonStamped.h>
 #include <nav_msgs/Odometry.h>
 #include <sensor_msgs/LaserScan.h>
@@ -11,6 +12,7 @@
 #include "hidden_rooms/common/input_error.h"
 #include "hidden_rooms/common/occupancy_grid.h"
 #include "hidden_rooms/ros/conversions.h"
+#include "hidden_rooms/ros/parameters.h"
 #include "hidden_rooms/world/environment.h"
 
 namespace hidden_rooms {
@@ -19,12 +21,56 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-// A [x, y, yaw] list parameter; false when it is not set or empty.
+// The walls as rendered: door_width (~wall_thickness is optional, read by hand).
+const common::OptionTable<world::RenderOptions>& renderOptionTable() {
+  using O = world::RenderOptions;
+  static const common::OptionTable<O> table{
+      {"door_width", &O::door_width, "the walls as rendered: gap at open doors, metres", common::above(0)},
+  };
+  return table;
+}
+
+std::string poseText(const common::Pose2& pose) {
+  return "[" + common::formatNumber(pose.x) + ", " + common::formatNumber(pose.y) + ", " +
+         common::formatNumber(pose.yaw) + "]";
+}
+
+// The parameters readSimulatorOptions reads by explicit code, as docs/ros_api.md lists them.
+std::vector<common::OptionDescription> explicitParameters() {
+  const SimulatorOptions defaults;
+  const simulation::SimulationOptions& simulation = defaults.simulation;
+  const simulation::OdometryNoiseOptions& noise = simulation.odometry_noise;
+  return {
+      {"closed_doors", "string", "\"" + defaults.closed_doors + "\"", "environment doors closed at start"},
+      {"wall_thickness", "double", "0", "the walls as rendered, metres; 0 = the file's own, else 0.15"},
+      {"seed", "int", std::to_string(simulation.seed), "random seed (laser noise, odometry error)"},
+      {"laser_field_of_view", "double", common::formatNumber(simulation.laser.field_of_view * 180.0 / kPi),
+       "degrees, centred on the laser's x axis"},
+      {"laser_caster", "string", "\"" + std::string(simulation::toString(simulation.laser.caster)) + "\"",
+       "box2d or grid"},
+      {"laser_pose", "[x, y, yaw]", poseText(simulation.laser.mount), "base_link -> base_laser_link"},
+      {"odom_error", "[x, y, yaw]", poseText({noise.x, noise.y, noise.yaw}), "Stage's odom_error"},
+      {"start_pose", "[x, y, yaw]", "[]", "start pose in the world frame; empty = chosen"},
+  };
+}
+
+// A [x, y, yaw] list parameter of finite numbers; false when it is not set or empty. Throws InputError("~name")
+// for anything else.
 bool readPose(const ros::NodeHandle& nh, const std::string& name, common::Pose2* pose) {
-  std::vector<double> values;
-  if (!nh.getParam(name, values) || values.empty()) return false;
-  if (values.size() != 3) throw common::InputError("~" + name, "must be a list [x, y, yaw]");
-  *pose = {values[0], values[1], values[2]};
+  XmlRpc::XmlRpcValue value;
+  if (!nh.getParam(name, value)) return false;
+  const common::InputError bad("~" + name, "must be a list [x, y, yaw] of finite numbers");
+  if (value.getType() != XmlRpc::XmlRpcValue::TypeArray) throw bad;
+  if (value.size() == 0) return false;
+  if (value.size() != 3) throw bad;
+  double xyz[3];
+  for (int k = 0; k < 3; ++k) {
+    const bool is_int = value[k].getType() == XmlRpc::XmlRpcValue::TypeInt;
+    if (!is_int && value[k].getType() != XmlRpc::XmlRpcValue::TypeDouble) throw bad;
+    xyz[k] = is_int ? static_cast<int>(value[k]) : static_cast<double>(value[k]);
+    if (!std::isfinite(xyz[k])) throw bad;
+  }
+  *pose = {xyz[0], xyz[1], xyz[2]};
   return true;
 }
 
@@ -47,68 +93,82 @@ uint64_t periodInSteps(double rate, double physics_step, const std::string& name
 
 }  // namespace
 
+const common::OptionTable<SimulatorOptions>& simulatorNodeOptionTable() {
+  using O = SimulatorOptions;
+  static const common::OptionTable<O> table{
+      {"environment", &O::environment, "environment XML (set exactly one of this, ~map_file, ~bitmap)"},
+      {"map_file", &O::map_file, "map_server yaml of a bitmap world"},
+      {"bitmap", &O::bitmap, "Stage-style image (dark = wall), lower-left corner at the origin"},
+      {"bitmap_resolution", &O::bitmap_resolution, "metres per pixel of ~bitmap", common::above(0)},
+      {"realtime_factor", &O::realtime_factor, "simulated seconds per wall-clock second; 0 = as fast as possible",
+       common::atLeast(0)},
+      {"laser_rate", &O::laser_rate, "Hz of simulated time (base_scan)", common::above(0)},
+      {"odom_rate", &O::odom_rate, "Hz of simulated time (odom, base_pose_ground_truth, tf)", common::above(0)},
+      {"clock_rate", &O::clock_rate, "Hz of simulated time (/clock)", common::above(0)},
+      {"duration", &O::duration, "simulated seconds after which the node exits; 0 = until shut down",
+       common::atLeast(0)},
+      {"world_frame", &O::world_frame, "frame of the world (environment / map)"},
+      {"odom_frame", &O::odom_frame, "frame of the odometry"},
+      {"base_frame", &O::base_frame, "frame of the robot"},
+      {"laser_frame", &O::laser_frame, "frame of the laser"},
+      {"publish_world_to_odom", &O::publish_world_to_odom, "static tf world -> odom at the start pose"},
+  };
+  return table;
+}
+
+std::vector<common::OptionDescription> simulatorParameters() {
+  std::vector<common::OptionDescription> rows;
+  for (const std::vector<common::OptionDescription>& more :
+       {common::describeOptions(simulatorNodeOptionTable()), common::describeOptions(renderOptionTable()),
+        common::describeOptions(simulation::simulationOptionTable()),
+        common::describeOptions(simulation::robotOptionTable()),
+        common::describeOptions(simulation::laserOptionTable()), explicitParameters()})
+    rows.insert(rows.end(), more.begin(), more.end());
+  return rows;
+}
+
 SimulatorOptions readSimulatorOptions(const ros::NodeHandle& nh) {
   SimulatorOptions options;
-  nh.param("environment", options.environment, options.environment);
-  nh.param("map_file", options.map_file, options.map_file);
-  nh.param("bitmap", options.bitmap, options.bitmap);
-  nh.param("bitmap_resolution", options.bitmap_resolution, options.bitmap_resolution);
+  readParameters(nh, simulatorNodeOptionTable(), &options);
   options.closed_doors = readText(nh, "closed_doors", options.closed_doors);
-  nh.param("door_width", options.render.door_width, options.render.door_width);
-  double wall_thickness = 0.0;
-  if (nh.getParam("wall_thickness", wall_thickness) && wall_thickness > 0.0) options.render.wall_thickness = wall_thickness;
+  readParameters(nh, renderOptionTable(), &options.render);
+  double wall_thickness = 0.0;  // 0 (or less): the file's own
+  readParameter(nh, "wall_thickness", &wall_thickness);
+  if (wall_thickness > 0.0) options.render.wall_thickness = wall_thickness;
 
   simulation::SimulationOptions& simulation = options.simulation;
-  nh.param("physics_step", simulation.physics_step, simulation.physics_step);
-  int seed = 0;
-  nh.param("seed", seed, seed);
+  readParameters(nh, simulation::simulationOptionTable(), &simulation);
+  int seed = static_cast<int>(simulation.seed);
+  readParameter(nh, "seed", &seed);
   if (seed < 0) throw common::InputError("~seed", "must be zero or positive");
   simulation.seed = static_cast<uint64_t>(seed);
-  simulation::RobotOptions& robot = simulation.robot;
-  nh.param("footprint_length", robot.length, robot.length);
-  nh.param("footprint_width", robot.width, robot.width);
-  nh.param("max_linear_velocity", robot.max_linear_velocity, robot.max_linear_velocity);
-  nh.param("max_angular_velocity", robot.max_angular_velocity, robot.max_angular_velocity);
-  nh.param("linear_acceleration", robot.linear_acceleration, robot.linear_acceleration);
-  nh.param("angular_acceleration", robot.angular_acceleration, robot.angular_acceleration);
-  nh.param("watchdog_timeout", robot.watchdog_timeout, robot.watchdog_timeout);
+  readParameters(nh, simulation::robotOptionTable(), &simulation.robot);
   simulation::LaserOptions& laser = simulation.laser;
-  nh.param("laser_beams", laser.beams, laser.beams);
+  readParameters(nh, simulation::laserOptionTable(), &laser);
   double field_of_view_degrees = laser.field_of_view * 180.0 / kPi;
-  nh.param("laser_field_of_view", field_of_view_degrees, field_of_view_degrees);
+  readParameter(nh, "laser_field_of_view", &field_of_view_degrees);
+  if (!(field_of_view_degrees > 0.0 && field_of_view_degrees <= 360.0))
+    throw common::InputError("~laser_field_of_view",
+                             "must be in (0, 360] degrees, got " + common::formatNumber(field_of_view_degrees));
   laser.field_of_view = field_of_view_degrees * kPi / 180.0;
-  nh.param("laser_min_range", laser.min_range, laser.min_range);
-  nh.param("laser_max_range", laser.max_range, laser.max_range);
-  nh.param("laser_range_noise", laser.range_noise, laser.range_noise);
-  nh.param("laser_max_range_probability", laser.max_range_probability, laser.max_range_probability);
   readPose(nh, "laser_pose", &laser.mount);
-  std::string caster = toString(laser.caster);
-  nh.param("laser_caster", caster, caster);
-  laser.caster = simulation::laserCasterFromString(caster);
-  nh.param("laser_grid_resolution", laser.grid_resolution, laser.grid_resolution);
-  common::Pose2 odom_error{simulation.odometry_noise.x, simulation.odometry_noise.y, simulation.odometry_noise.yaw};
+  std::string caster = simulation::toString(laser.caster);
+  readParameter(nh, "laser_caster", &caster);
+  try {
+    laser.caster = simulation::laserCasterFromString(caster);
+  } catch (const common::InputError& error) {
+    throw common::InputError("~laser_caster", error.problem());
+  }
+  simulation::OdometryNoiseOptions& noise = simulation.odometry_noise;
+  common::Pose2 odom_error{noise.x, noise.y, noise.yaw};
   readPose(nh, "odom_error", &odom_error);
-  simulation.odometry_noise = {odom_error.x, odom_error.y, odom_error.yaw};
+  for (double error : {odom_error.x, odom_error.y, odom_error.yaw})
+    if (error < 0.0 || error >= 2.0) throw common::InputError("~odom_error", "must be in [0, 2) per axis");
+  noise = {odom_error.x, odom_error.y, odom_error.yaw};
   common::Pose2 start;
   if (readPose(nh, "start_pose", &start)) simulation.start_pose = start;
-  validate(simulation);
+  validate(simulation);  // the rules between parameters
 
-  nh.param("realtime_factor", options.realtime_factor, options.realtime_factor);
-  nh.param("laser_rate", options.laser_rate, options.laser_rate);
-  nh.param("odom_rate", options.odom_rate, options.odom_rate);
-  nh.param("clock_rate", options.clock_rate, options.clock_rate);
-  nh.param("duration", options.duration, options.duration);
-  nh.param("world_frame", options.world_frame, options.world_frame);
-  nh.param("odom_frame", options.odom_frame, options.odom_frame);
-  nh.param("base_frame", options.base_frame, options.base_frame);
-  nh.param("laser_frame", options.laser_frame, options.laser_frame);
-  nh.param("publish_world_to_odom", options.publish_world_to_odom, options.publish_world_to_odom);
-  if (!std::isfinite(options.realtime_factor) || options.realtime_factor < 0.0)
-    throw common::InputError("~realtime_factor", "must be zero (as fast as possible) or positive");
-  if (!std::isfinite(options.duration) || options.duration < 0.0)
-    throw common::InputError("~duration", "must be zero (no limit) or positive");
-  if (!std::isfinite(options.bitmap_resolution) || options.bitmap_resolution <= 0.0)
-    throw common::InputError("~bitmap_resolution", "must be positive");
   const int sources = !options.environment.empty() + !options.map_file.empty() + !options.bitmap.empty();
   if (sources != 1)
     throw common::InputError(nh.getNamespace(), "set exactly one of ~environment, ~map_file and ~bitmap");

@@ -277,32 +277,57 @@ LaserCasterKind laserCasterFromString(const std::string& name) {
   throw common::InputError("simulation options", "laser caster must be 'box2d' or 'grid', not '" + name + "'");
 }
 
+const common::OptionTable<SimulationOptions>& simulationOptionTable() {
+  using O = SimulationOptions;
+  static const common::OptionTable<O> table{
+      {"physics_step", &O::physics_step, "fixed Box2D step, simulated seconds", common::ParameterRange{0, 0.1, true}},
+  };
+  return table;
+}
+
+const common::OptionTable<RobotOptions>& robotOptionTable() {
+  using O = RobotOptions;
+  static const common::OptionTable<O> table{
+      {"footprint_length", &O::length, "robot box along x, metres, centred on base_link", common::above(0)},
+      {"footprint_width", &O::width, "robot box along y, metres", common::above(0)},
+      {"max_linear_velocity", &O::max_linear_velocity, "m/s", common::above(0)},
+      {"max_angular_velocity", &O::max_angular_velocity, "rad/s", common::above(0)},
+      {"linear_acceleration", &O::linear_acceleration, "m/s^2", common::above(0)},
+      {"angular_acceleration", &O::angular_acceleration, "rad/s^2", common::above(0)},
+      {"watchdog_timeout", &O::watchdog_timeout, "simulated seconds without a command before stopping; 0 = never",
+       common::atLeast(0)},
+  };
+  return table;
+}
+
+const common::OptionTable<LaserOptions>& laserOptionTable() {
+  using O = LaserOptions;
+  static const common::OptionTable<O> table{
+      {"laser_beams", &O::beams, "beams", common::between(1, 100000)},
+      {"laser_min_range", &O::min_range, "metres", common::atLeast(0)},
+      {"laser_max_range", &O::max_range, "metres", common::above(0)},
+      {"laser_range_noise", &O::range_noise, "standard deviation of the Gaussian range noise, metres",
+       common::atLeast(0)},
+      {"laser_max_range_probability", &O::max_range_probability, "chance of a spurious max-range return per beam",
+       common::between(0, 1)},
+      {"laser_grid_resolution", &O::grid_resolution, "cell size of the grid caster, metres", common::above(0)},
+  };
+  return table;
+}
+
 void validate(const SimulationOptions& options) {
+  common::validateOptions(simulationOptionTable(), options);
+  common::validateOptions(robotOptionTable(), options.robot);
+  common::validateOptions(laserOptionTable(), options.laser);
   auto require = [](bool ok, const std::string& problem) {
     if (!ok) throw common::InputError("simulation options", problem);
   };
-  auto positive = [](double value) { return std::isfinite(value) && value > 0.0; };
   auto non_negative = [](double value) { return std::isfinite(value) && value >= 0.0; };
-  require(positive(options.physics_step) && options.physics_step <= 0.1, "physics_step must be in (0, 0.1] s");
-  const RobotOptions& robot = options.robot;
-  require(positive(robot.length) && positive(robot.width), "robot length and width must be positive");
-  require(positive(robot.max_linear_velocity) && positive(robot.max_angular_velocity),
-          "maximum velocities must be positive");
-  require(positive(robot.linear_acceleration) && positive(robot.angular_acceleration),
-          "acceleration limits must be positive");
-  require(non_negative(robot.watchdog_timeout), "watchdog_timeout must be zero (off) or positive");
   const LaserOptions& laser = options.laser;
-  require(laser.beams >= 1 && laser.beams <= 100000, "laser beams must be between 1 and 100000");
-  require(positive(laser.field_of_view) && laser.field_of_view <= 2.0 * kPi,
+  require(std::isfinite(laser.field_of_view) && laser.field_of_view > 0.0 && laser.field_of_view <= 2.0 * kPi,
           "laser field of view must be in (0, 2 pi]");
-  require(non_negative(laser.min_range) && positive(laser.max_range) && laser.min_range < laser.max_range,
-          "laser ranges must satisfy 0 <= min_range < max_range");
-  require(non_negative(laser.range_noise), "laser range_noise must be zero or positive");
-  require(std::isfinite(laser.max_range_probability) && laser.max_range_probability >= 0.0 &&
-              laser.max_range_probability <= 1.0,
-          "max_range_probability must be in [0, 1]");
+  require(laser.min_range < laser.max_range, "need laser_min_range < laser_max_range");
   require(finite(laser.mount), "laser mount pose must be finite");
-  require(positive(laser.grid_resolution), "laser grid_resolution must be positive");
   const OdometryNoiseOptions& noise = options.odometry_noise;
   require(non_negative(noise.x) && non_negative(noise.y) && non_negative(noise.yaw) && noise.x < 2.0 &&
               noise.y < 2.0 && noise.yaw < 2.0,

@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "hidden_rooms/ros/explorer.h"
+#include "hidden_rooms/ros/simulator.h"
 
 namespace hidden_rooms {
 namespace {
@@ -53,7 +54,9 @@ std::map<std::string, DocumentedParameter> documentedParameters(const std::strin
     const std::regex name_pattern("`~(\\w+)`");
     for (std::sregex_iterator it(columns[0].begin(), columns[0].end(), name_pattern), end; it != end; ++it)
       names.push_back((*it)[1]);
-    const std::vector<std::string> defaults = split(columns[2], ", ");
+    // One name: the whole column is its default (a list such as "[0.2, 0, 0]" included).
+    const std::vector<std::string> defaults =
+        names.size() == 1 ? std::vector<std::string>{columns[2]} : split(columns[2], ", ");
     for (size_t k = 0; k < names.size(); ++k)
       parameters[names[k]] = {trimmed(columns[1]), trimmed(defaults.size() == names.size() ? defaults[k] : "?")};
   }
@@ -93,6 +96,11 @@ void expectDocumented(const std::string& node, const std::vector<common::OptionD
 
 TEST(ParameterDocs, ExplorerParametersAreDocumentedWithTheirTypesAndDefaults) {
   expectDocumented("explorer", explorerParameters());
+}
+
+// The simulator's tables and, listed by hand in simulatorParameters(), the parameters it reads by explicit code.
+TEST(ParameterDocs, SimulatorParametersAreDocumentedWithTheirTypesAndDefaults) {
+  expectDocumented("simulator", simulatorParameters());
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 #include <tf2_ros/static_transform_broadcaster.h>
 #include <tf2_ros/transform_broadcaster.h>
 
+#include "hidden_rooms/common/options.h"
 #include "hidden_rooms/simulation/simulation.h"
 #include "hidden_rooms/world/render.h"
 
@@ -37,6 +38,12 @@ struct SimulatorOptions {
   std::string laser_frame = "base_laser_link";
   bool publish_world_to_odom = false;  // tf world -> odom at the start pose (for viewing without SLAM)
 };
+
+// The node's own parameters (world source, rates, frames, ...); the simulation's are in the core's tables.
+const common::OptionTable<SimulatorOptions>& simulatorNodeOptionTable();
+// Every parameter of the node, as docs/ros_api.md lists them: the tables' and, by hand, those read by explicit
+// code (closed_doors, wall_thickness, seed, laser_field_of_view, laser_caster and the [x, y, yaw] poses).
+std::vector<common::OptionDescription> simulatorParameters();
 
 // Reads the options from the private node handle. Throws InputError for a bad value or a world source missing
 // or given twice.

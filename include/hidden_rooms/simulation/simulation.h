@@ -10,6 +10,7 @@
 
 #include "hidden_rooms/common/geometry.h"
 #include "hidden_rooms/common/occupancy_grid.h"
+#include "hidden_rooms/common/options.h"
 #include "hidden_rooms/common/velocity_command.h"
 #include "hidden_rooms/simulation/laser_caster.h"
 #include "hidden_rooms/world/environment.h"
@@ -104,7 +105,14 @@ struct SimulationOptions {
   std::optional<common::Pose2> start_pose;
 };
 
-// Throws InputError("simulation options", ...) naming the first bad option.
+// The simulator's parameters (docs/ros_api.md) with the ranges validate() enforces. Not in a table: seed (uint64),
+// start_pose, laser mount and odometry noise (poses), laser caster (enum), field_of_view (degrees as a parameter).
+const common::OptionTable<SimulationOptions>& simulationOptionTable();  // physics_step
+const common::OptionTable<RobotOptions>& robotOptionTable();
+const common::OptionTable<LaserOptions>& laserOptionTable();
+
+// Throws InputError("NAME", ...) for a field outside its table's range, InputError("simulation options", ...) for
+// the other rules (field_of_view, min_range < max_range, odometry noise, finite poses).
 void validate(const SimulationOptions& options);
 
 // How far the two casters agree on one scan: a beam agrees when both ranges are within `tolerance`, or when both
