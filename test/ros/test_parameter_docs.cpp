@@ -12,6 +12,10 @@
 #include <gtest/gtest.h>
 
 #include "hidden_rooms/ros/explorer.h"
+#include "hidden_rooms/ros/map_publisher.h"
+#include "hidden_rooms/ros/mapper.h"
+#include "hidden_rooms/ros/pose_logger.h"
+#include "hidden_rooms/ros/room_predictor.h"
 
 namespace hidden_rooms {
 namespace {
@@ -91,8 +95,35 @@ void expectDocumented(const std::string& node, const std::vector<common::OptionD
     EXPECT_TRUE(in_table.count(name)) << node << ": docs/ros_api.md documents ~" << name << ", which it does not read";
 }
 
+// `rows` and one parameter a node reads apart from its tables.
+std::vector<common::OptionDescription> with(std::vector<common::OptionDescription> rows,
+                                            const common::OptionDescription& row) {
+  rows.push_back(row);
+  return rows;
+}
+
 TEST(ParameterDocs, ExplorerParametersAreDocumentedWithTheirTypesAndDefaults) {
   expectDocumented("explorer", explorerParameters());
+}
+
+TEST(ParameterDocs, MapperParametersAreDocumentedWithTheirTypesAndDefaults) {
+  // ~seed is read apart (an unsigned seed): its row by hand.
+  expectDocumented("mapper", with(mapperParameters(), {"seed", "int", "0", "seed of MRPT's random generator"}));
+}
+
+TEST(ParameterDocs, PoseLoggerParametersAreDocumentedWithTheirTypesAndDefaults) {
+  expectDocumented("pose_logger", poseLoggerParameters());
+}
+
+TEST(ParameterDocs, MapPublisherParametersAreDocumentedWithTheirTypesAndDefaults) {
+  // Read apart (a door number roslaunch types as an int; a thickness that applies only when > 0): rows by hand.
+  expectDocumented("map_publisher",
+                   with(with(mapPublisherParameters(), {"closed_doors", "string", "\"\"", "doors drawn closed"}),
+                        {"wall_thickness", "double", "0", "rendering: metres"}));
+}
+
+TEST(ParameterDocs, RoomPredictorParametersAreDocumentedWithTheirTypesAndDefaults) {
+  expectDocumented("room_predictor", roomPredictorParameters());
 }
 
 }  // namespace
