@@ -78,6 +78,15 @@ mrpt::maps::COccupancyGridMap2D::TInsertionOptions readPublishedInsertion(
 
 }  // namespace
 
+const common::OptionTable<RbpfMapperOptions>& rbpfMapperOptionTable() {
+  using O = RbpfMapperOptions;
+  static const common::OptionTable<O> table{
+      {"config_file", &O::config_file, "MRPT ini (filter, grids, [PublishedMap], [MotionModel]); required"},
+      {"config_section", &O::section, "section of the ini with the filter's options"},
+  };
+  return table;
+}
+
 struct RbpfMapper::Impl {
   std::unique_ptr<mrpt::slam::CMetricMapBuilderRBPF> builder;
   mrpt::obs::CActionRobotMovement2D::TMotionModelOptions motion_model;

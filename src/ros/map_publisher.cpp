@@ -1,25 +1,49 @@
 #include "hidden_rooms/ros/map_publisher.h"
 
+#include <XmlRpcValue.h>
 #include <nav_msgs/MapMetaData.h>
 
 #include "hidden_rooms/common/input_error.h"
 #include "hidden_rooms/ros/conversions.h"
+#include "hidden_rooms/ros/parameters.h"
 #include "hidden_rooms/world/environment.h"
 
 namespace hidden_rooms {
 
+const common::OptionTable<MapPublisherOptions>& mapPublisherNodeOptionTable() {
+  using O = MapPublisherOptions;
+  static const common::OptionTable<O> table{
+      {"map_file", &O::map_file, "map_server yaml to publish (set this or ~environment)"},
+      {"environment", &O::environment, "environment XML to render and publish"},
+      {"frame_id", &O::frame_id, "frame of the published map"},
+  };
+  return table;
+}
+
+std::vector<common::OptionDescription> mapPublisherParameters() {
+  std::vector<common::OptionDescription> rows = common::describeOptions(mapPublisherNodeOptionTable());
+  const std::vector<common::OptionDescription> render = common::describeOptions(world::renderOptionTable());
+  rows.insert(rows.end(), render.begin(), render.end());
+  // Read apart: a door number roslaunch types as an int; a thickness that applies only when > 0.
+  rows.push_back({"closed_doors", "string", "\"\"", "doors drawn closed"});
+  rows.push_back({"wall_thickness", "double", "0", "rendering: metres"});
+  return rows;
+}
+
 MapPublisherOptions readMapPublisherOptions(const ros::NodeHandle& private_nh) {
   MapPublisherOptions options;
-  private_nh.param("map_file", options.map_file, options.map_file);
-  private_nh.param("environment", options.environment, options.environment);
-  private_nh.param("closed_doors", options.closed_doors, options.closed_doors);
-  private_nh.param("frame_id", options.frame_id, options.frame_id);
-  private_nh.param("resolution", options.render.resolution, options.render.resolution);
-  private_nh.param("door_width", options.render.door_width, options.render.door_width);
-  private_nh.param("margin", options.render.margin, options.render.margin);
+  readParameters(private_nh, mapPublisherNodeOptionTable(), &options);
+  // Text that roslaunch types as an int when it is a single door number ("3" -> 3).
+  XmlRpc::XmlRpcValue closed_doors;
+  if (private_nh.getParam("closed_doors", closed_doors) && closed_doors.getType() == XmlRpc::XmlRpcValue::TypeInt)
+    options.closed_doors = std::to_string(static_cast<int>(closed_doors));
+  else
+    readParameter(private_nh, "closed_doors", &options.closed_doors);
+  readParameters(private_nh, world::renderOptionTable(), &options.render);
+  // Optional: only a positive value replaces the environment's own thickness.
   double wall_thickness = 0.0;
-  if (private_nh.getParam("wall_thickness", wall_thickness) && wall_thickness > 0.0)
-    options.render.wall_thickness = wall_thickness;
+  readParameter(private_nh, "wall_thickness", &wall_thickness);
+  if (wall_thickness > 0.0) options.render.wall_thickness = wall_thickness;
   if (options.map_file.empty() == options.environment.empty())
     throw common::InputError(private_nh.getNamespace(), "set exactly one of ~map_file and ~environment");
   return options;

@@ -1,7 +1,5 @@
 #include "hidden_rooms/ros/mapper.h"
 
-#include <cmath>
-
 #include <geometry_msgs/PoseArray.h>
 #include <nav_msgs/MapMetaData.h>
 #include <nav_msgs/OccupancyGrid.h>
@@ -10,38 +8,49 @@
 #include "hidden_rooms/common/occupancy_grid.h"
 #include "hidden_rooms/ros/conversions.h"
 #include "hidden_rooms/ros/mrpt_scan.h"
+#include "hidden_rooms/ros/parameters.h"
 
 namespace hidden_rooms {
 
+const common::OptionTable<MapperOptions>& mapperNodeOptionTable() {
+  using O = MapperOptions;
+  static const common::OptionTable<O> table{
+      {"scan_topic", &O::scan_topic, "laser topic"},
+      {"map_frame", &O::map_frame, "frame of the map", common::anyFinite(), true},
+      {"odom_frame", &O::odom_frame, "frame of the odometry", common::anyFinite(), true},
+      {"base_frame", &O::base_frame, "frame of the robot", common::anyFinite(), true},
+      {"map_update_interval", &O::map_update_interval, "seconds (ROS time) between map publications",
+       common::atLeast(0)},
+      {"tf_publish_rate", &O::tf_publish_rate, "Hz of map -> odom; 0 = after each scan", common::atLeast(0)},
+      {"transform_tolerance", &O::transform_tolerance, "seconds map -> odom is stamped ahead", common::atLeast(0)},
+      {"tf_wait", &O::tf_wait, "seconds (scan time) a scan waits for its odometry before it is dropped",
+       common::atLeast(0)},
+      {"future_stamp_tolerance", &O::future_stamp_tolerance,
+       "seconds a scan may be stamped ahead of ROS time; 0 = no check", common::atLeast(0)},
+      {"publish_particles", &O::publish_particles, "publish particles"},
+  };
+  return table;
+}
+
+std::vector<common::OptionDescription> mapperParameters() {
+  std::vector<common::OptionDescription> rows = common::describeOptions(mapping::rbpfMapperOptionTable());
+  const std::vector<common::OptionDescription> node = common::describeOptions(mapperNodeOptionTable());
+  rows.insert(rows.end(), node.begin(), node.end());
+  rows.push_back({"seed", "int", "0", "seed of MRPT's random generator"});  // read apart: an unsigned seed
+  return rows;
+}
+
 MapperOptions readMapperOptions(const ros::NodeHandle& nh) {
   MapperOptions options;
-  nh.param("config_file", options.rbpf.config_file, options.rbpf.config_file);
-  nh.param("config_section", options.rbpf.section, options.rbpf.section);
+  readParameters(nh, mapping::rbpfMapperOptionTable(), &options.rbpf);
+  // The seed is unsigned: read as an int (all XML-RPC has), then checked.
   int seed = 0;
-  nh.param("seed", seed, seed);
+  readParameter(nh, "seed", &seed);
   if (seed < 0) throw common::InputError("~seed", "must be zero or positive");
   options.rbpf.seed = static_cast<uint32_t>(seed);
-  nh.param("scan_topic", options.scan_topic, options.scan_topic);
-  nh.param("map_frame", options.map_frame, options.map_frame);
-  nh.param("odom_frame", options.odom_frame, options.odom_frame);
-  nh.param("base_frame", options.base_frame, options.base_frame);
-  nh.param("map_update_interval", options.map_update_interval, options.map_update_interval);
-  nh.param("tf_publish_rate", options.tf_publish_rate, options.tf_publish_rate);
-  nh.param("transform_tolerance", options.transform_tolerance, options.transform_tolerance);
-  nh.param("tf_wait", options.tf_wait, options.tf_wait);
-  nh.param("future_stamp_tolerance", options.future_stamp_tolerance, options.future_stamp_tolerance);
-  nh.param("publish_particles", options.publish_particles, options.publish_particles);
   if (options.rbpf.config_file.empty())
     throw common::InputError("~config_file", "must name the MRPT ini (config/rbpf.ini)");
-  for (const auto& [name, value] : {std::pair<const char*, double>{"map_update_interval", options.map_update_interval},
-                                    {"tf_publish_rate", options.tf_publish_rate},
-                                    {"transform_tolerance", options.transform_tolerance},
-                                    {"tf_wait", options.tf_wait},
-                                    {"future_stamp_tolerance", options.future_stamp_tolerance}})
-    if (!std::isfinite(value) || value < 0.0)
-      throw common::InputError(std::string("~") + name, "must be zero or positive");
-  for (const std::string* frame : {&options.map_frame, &options.odom_frame, &options.base_frame})
-    if (frame->empty()) throw common::InputError("~map_frame, ~odom_frame, ~base_frame", "must not be empty");
+  readParameters(nh, mapperNodeOptionTable(), &options);
   return options;
 }
 

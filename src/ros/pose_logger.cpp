@@ -9,6 +9,7 @@
 #include "hidden_rooms/common/input_error.h"
 #include "hidden_rooms/common/pose_log.h"
 #include "hidden_rooms/ros/conversions.h"
+#include "hidden_rooms/ros/parameters.h"
 
 namespace hidden_rooms {
 
@@ -35,19 +36,27 @@ bool emptyFile(const std::string& path) {
 
 }  // namespace
 
+const common::OptionTable<PoseLoggerOptions>& poseLoggerNodeOptionTable() {
+  using O = PoseLoggerOptions;
+  static const common::OptionTable<O> table{
+      {"estimate_log", &O::estimate_log, "the map -> base_link log (its folder is created)", common::anyFinite(), true},
+      {"ground_truth_log", &O::ground_truth_log, "the ground-truth log; \"\" = not logged"},
+      {"map_frame", &O::map_frame, "parent frame of the estimate", common::anyFinite(), true},
+      {"base_frame", &O::base_frame, "the robot's frame", common::anyFinite(), true},
+      {"ground_truth_topic", &O::ground_truth_topic, "topic of the true pose"},
+      {"period", &O::period, "seconds of ROS time between logged poses", common::above(0)},
+      {"append", &O::append, "continue existing logs instead of starting them afresh"},
+  };
+  return table;
+}
+
+std::vector<common::OptionDescription> poseLoggerParameters() {
+  return common::describeOptions(poseLoggerNodeOptionTable());
+}
+
 PoseLoggerOptions readPoseLoggerOptions(const ros::NodeHandle& private_nh) {
   PoseLoggerOptions options;
-  private_nh.param("estimate_log", options.estimate_log, options.estimate_log);
-  private_nh.param("ground_truth_log", options.ground_truth_log, options.ground_truth_log);
-  private_nh.param("map_frame", options.map_frame, options.map_frame);
-  private_nh.param("base_frame", options.base_frame, options.base_frame);
-  private_nh.param("ground_truth_topic", options.ground_truth_topic, options.ground_truth_topic);
-  private_nh.param("period", options.period, options.period);
-  private_nh.param("append", options.append, options.append);
-  if (!std::isfinite(options.period) || options.period <= 0.0) throw common::InputError("~period", "must be positive");
-  if (options.estimate_log.empty()) throw common::InputError("~estimate_log", "must name a file");
-  if (options.map_frame.empty() || options.base_frame.empty())
-    throw common::InputError("~map_frame, ~base_frame", "must not be empty");
+  readParameters(private_nh, poseLoggerNodeOptionTable(), &options);
   return options;
 }
 

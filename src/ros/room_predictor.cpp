@@ -12,27 +12,37 @@
 #include "hidden_rooms/prediction/prediction_support.h"
 #include "hidden_rooms/ros/conversions.h"
 #include "hidden_rooms/ros/markers.h"
+#include "hidden_rooms/ros/parameters.h"
 
 namespace hidden_rooms {
 
+const common::OptionTable<RoomPredictorOptions>& roomPredictorNodeOptionTable() {
+  using O = RoomPredictorOptions;
+  static const common::OptionTable<O> table{
+      {"method", &O::method, "method of requests that name none, and of ~predict_on_map"},
+      {"closed_doors_file", &O::closed_doors_file, "doors.yaml: the doors of requests that give none"},
+      {"params_file", &O::params_file, "flat `name: number` overrides applied to every request"},
+      {"predict_on_map", &O::predict_on_map, "predict the file's doors on every new map (needs ~closed_doors_file)"},
+      {"publish_debug", &O::publish_debug, "add the layout analysis namespaces to predicted_rooms"},
+      {"frame_id", &O::frame_id, "frame of the outputs when the map's header.frame_id is empty"},
+      {"octomap_file", &O::octomap_file, "a 3D map as map source, sliced at start"},
+      {"octomap_z_min", &O::octomap_z_min, "metres: bottom of the height band of ~octomap_file"},
+      {"octomap_z_max", &O::octomap_z_max, "metres: top of the height band of ~octomap_file"},
+      {"octomap_out", &O::octomap_out, "after each prediction, the completed map extruded into 3D and written here"},
+      {"octomap_height", &O::octomap_height, "metres: height of the extruded walls and free space", common::above(0)},
+      {"max_doors", &O::max_doors, "requests with more doors are refused", common::atLeast(1)},
+      {"max_map_cells", &O::max_map_cells, "maps with more cells (width x height) are refused", common::atLeast(1)},
+  };
+  return table;
+}
+
+std::vector<common::OptionDescription> roomPredictorParameters() {
+  return common::describeOptions(roomPredictorNodeOptionTable());
+}
+
 RoomPredictorOptions readRoomPredictorOptions(const ros::NodeHandle& private_nh) {
   RoomPredictorOptions options;
-  private_nh.param("method", options.method, options.method);
-  private_nh.param("closed_doors_file", options.closed_doors_file, options.closed_doors_file);
-  private_nh.param("params_file", options.params_file, options.params_file);
-  private_nh.param("predict_on_map", options.predict_on_map, options.predict_on_map);
-  private_nh.param("publish_debug", options.publish_debug, options.publish_debug);
-  private_nh.param("frame_id", options.frame_id, options.frame_id);
-  private_nh.param("octomap_file", options.octomap_file, options.octomap_file);
-  private_nh.param("octomap_z_min", options.octomap_z_min, options.octomap_z_min);
-  private_nh.param("octomap_z_max", options.octomap_z_max, options.octomap_z_max);
-  private_nh.param("octomap_out", options.octomap_out, options.octomap_out);
-  private_nh.param("octomap_height", options.octomap_height, options.octomap_height);
-  private_nh.param("max_doors", options.max_doors, options.max_doors);
-  private_nh.param("max_map_cells", options.max_map_cells, options.max_map_cells);
-  if (!(options.octomap_height > 0.0)) throw common::InputError("~octomap_height", "must be positive");
-  if (options.max_doors < 1 || options.max_map_cells < 1)
-    throw common::InputError("~max_doors, ~max_map_cells", "must be at least 1");
+  readParameters(private_nh, roomPredictorNodeOptionTable(), &options);
   if (options.predict_on_map && options.closed_doors_file.empty())
     throw common::InputError(private_nh.getNamespace(), "~predict_on_map needs ~closed_doors_file");
   return options;

@@ -22,7 +22,7 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 
 // The walls as rendered: door_width (~wall_thickness is optional, read by hand).
-const common::OptionTable<world::RenderOptions>& renderOptionTable() {
+const common::OptionTable<world::RenderOptions>& simulatorRenderOptionTable() {
   using O = world::RenderOptions;
   static const common::OptionTable<O> table{
       {"door_width", &O::door_width, "the walls as rendered: gap at open doors, metres", common::above(0)},
@@ -119,7 +119,7 @@ const common::OptionTable<SimulatorOptions>& simulatorNodeOptionTable() {
 std::vector<common::OptionDescription> simulatorParameters() {
   std::vector<common::OptionDescription> rows;
   for (const std::vector<common::OptionDescription>& more :
-       {common::describeOptions(simulatorNodeOptionTable()), common::describeOptions(renderOptionTable()),
+       {common::describeOptions(simulatorNodeOptionTable()), common::describeOptions(simulatorRenderOptionTable()),
         common::describeOptions(simulation::simulationOptionTable()),
         common::describeOptions(simulation::robotOptionTable()),
         common::describeOptions(simulation::laserOptionTable()), explicitParameters()})
@@ -131,7 +131,7 @@ SimulatorOptions readSimulatorOptions(const ros::NodeHandle& nh) {
   SimulatorOptions options;
   readParameters(nh, simulatorNodeOptionTable(), &options);
   options.closed_doors = readText(nh, "closed_doors", options.closed_doors);
-  readParameters(nh, renderOptionTable(), &options.render);
+  readParameters(nh, simulatorRenderOptionTable(), &options.render);
   double wall_thickness = 0.0;  // 0 (or less): the file's own
   readParameter(nh, "wall_thickness", &wall_thickness);
   if (wall_thickness > 0.0) options.render.wall_thickness = wall_thickness;

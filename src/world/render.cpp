@@ -65,6 +65,16 @@ void validate(const RenderOptions& options, double wall_thickness) {
 
 }  // namespace
 
+const common::OptionTable<RenderOptions>& renderOptionTable() {
+  using O = RenderOptions;
+  static const common::OptionTable<O> table{
+      {"resolution", &O::resolution, "rendering: metres per cell", common::above(0)},
+      {"door_width", &O::door_width, "rendering: gap at open doors, metres", common::above(0)},
+      {"margin", &O::margin, "rendering: unknown border, metres", common::atLeast(0)},
+  };
+  return table;
+}
+
 WallGeometry wallGeometry(const Environment& environment, const std::set<int>& open_door_indices,
                           const RenderOptions& options) {
   const double thickness =

@@ -12,6 +12,10 @@
 #include <gtest/gtest.h>
 
 #include "hidden_rooms/ros/explorer.h"
+#include "hidden_rooms/ros/map_publisher.h"
+#include "hidden_rooms/ros/mapper.h"
+#include "hidden_rooms/ros/pose_logger.h"
+#include "hidden_rooms/ros/room_predictor.h"
 #include "hidden_rooms/ros/simulator.h"
 
 namespace hidden_rooms {
@@ -98,9 +102,24 @@ TEST(ParameterDocs, ExplorerParametersAreDocumentedWithTheirTypesAndDefaults) {
   expectDocumented("explorer", explorerParameters());
 }
 
-// The simulator's tables and, listed by hand in simulatorParameters(), the parameters it reads by explicit code.
 TEST(ParameterDocs, SimulatorParametersAreDocumentedWithTheirTypesAndDefaults) {
   expectDocumented("simulator", simulatorParameters());
+}
+
+TEST(ParameterDocs, MapperParametersAreDocumentedWithTheirTypesAndDefaults) {
+  expectDocumented("mapper", mapperParameters());
+}
+
+TEST(ParameterDocs, PoseLoggerParametersAreDocumentedWithTheirTypesAndDefaults) {
+  expectDocumented("pose_logger", poseLoggerParameters());
+}
+
+TEST(ParameterDocs, MapPublisherParametersAreDocumentedWithTheirTypesAndDefaults) {
+  expectDocumented("map_publisher", mapPublisherParameters());
+}
+
+TEST(ParameterDocs, RoomPredictorParametersAreDocumentedWithTheirTypesAndDefaults) {
+  expectDocumented("room_predictor", roomPredictorParameters());
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "hidden_rooms/common/occupancy_grid.h"
+#include "hidden_rooms/common/options.h"
 #include "hidden_rooms/common/range_scan.h"
 
 namespace mrpt::obs {
@@ -22,6 +23,9 @@ struct RbpfMapperOptions {
   // Seed of MRPT's random generator: the same scans with the same seed give the same map.
   uint32_t seed = 0;
 };
+
+// The ini's file and section as parameters (config_file, config_section); the seed (unsigned) is not in it.
+const common::OptionTable<RbpfMapperOptions>& rbpfMapperOptionTable();
 
 // A particle of the filter: the robot pose (base_link in the map frame) and its normalised weight.
 struct RbpfParticle {

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include <nav_msgs/GetMap.h>
 #include <nav_msgs/OccupancyGrid.h>
@@ -19,7 +20,13 @@ struct MapPublisherOptions {
   std::string frame_id = "map";
 };
 
-// Reads the options from the private node handle. Throws InputError when neither or both sources are set.
+// The node's own parameters (sources, frame); the rendering's are in the core's table.
+const common::OptionTable<MapPublisherOptions>& mapPublisherNodeOptionTable();
+// Every parameter of the node, as docs/ros_api.md lists them (~closed_doors and ~wall_thickness, read apart,
+// listed by hand).
+std::vector<common::OptionDescription> mapPublisherParameters();
+// Reads the options from the private node handle. Throws InputError naming the first bad parameter, or when
+// neither or both sources are set.
 MapPublisherOptions readMapPublisherOptions(const ros::NodeHandle& private_nh);
 
 // map_server's job from the core loaders: publishes a map file or a rendered environment, latched, on `map`

@@ -5,6 +5,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <hidden_rooms/SaveMap.h>
 #include <ros/callback_queue.h>
@@ -36,7 +37,12 @@ struct MapperOptions {
   bool publish_particles = true;      // publish `particles` (geometry_msgs/PoseArray)
 };
 
-// Reads the options from the private node handle. Throws InputError for a bad value or a missing ~config_file.
+// The node's own parameters (topic, frames, rates, waits, particles); the ini's are in the core's table.
+const common::OptionTable<MapperOptions>& mapperNodeOptionTable();
+// Every parameter of the node, as docs/ros_api.md lists them (~seed, read apart, listed by hand).
+std::vector<common::OptionDescription> mapperParameters();
+// Reads the options from the private node handle. Throws InputError naming the first bad parameter or a missing
+// ~config_file.
 MapperOptions readMapperOptions(const ros::NodeHandle& private_nh);
 
 // SLAM node over the core's RbpfMapper: each scan of `scan_topic` with the odometry (tf odom -> base_link at the

@@ -3,11 +3,14 @@
 #include <fstream>
 #include <limits>
 #include <string>
+#include <vector>
 
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
+
+#include "hidden_rooms/common/options.h"
 
 namespace hidden_rooms {
 
@@ -24,7 +27,10 @@ struct PoseLoggerOptions {
   bool append = false;
 };
 
-// Reads the options from the private node handle; throws InputError for a bad value.
+// The node's parameters, as docs/ros_api.md lists them.
+const common::OptionTable<PoseLoggerOptions>& poseLoggerNodeOptionTable();
+std::vector<common::OptionDescription> poseLoggerParameters();
+// Reads the options from the private node handle; throws InputError naming the first bad parameter.
 PoseLoggerOptions readPoseLoggerOptions(const ros::NodeHandle& private_nh);
 
 // The thesis's tf listener: logs the robot's pose in the map (tf map -> base_link) at every multiple of `period`

@@ -4,6 +4,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <hidden_rooms/PredictRooms.h>
 #include <nav_msgs/OccupancyGrid.h>
@@ -11,6 +12,7 @@
 
 #include "hidden_rooms/common/doors_file.h"
 #include "hidden_rooms/common/occupancy_grid.h"
+#include "hidden_rooms/common/options.h"
 #include "hidden_rooms/prediction/room_predictor.h"
 
 namespace hidden_rooms {
@@ -34,8 +36,11 @@ struct RoomPredictorOptions {
   int max_map_cells = 25000000;    // 5000 x 5000 cells: 250 m x 250 m at 0.05 m
 };
 
-// Reads the options from the private node handle. Throws InputError for ~predict_on_map without doors or a
-// bad octomap option.
+// The node's parameters, as docs/ros_api.md lists them.
+const common::OptionTable<RoomPredictorOptions>& roomPredictorNodeOptionTable();
+std::vector<common::OptionDescription> roomPredictorParameters();
+// Reads the options from the private node handle. Throws InputError naming the first bad parameter, or for
+// ~predict_on_map without doors.
 RoomPredictorOptions readRoomPredictorOptions(const ros::NodeHandle& private_nh);
 
 // Serves `predict_rooms` (PredictRooms) over the latest map of `map` or the request's own map, and publishes

@@ -9,6 +9,7 @@
 
 #include "hidden_rooms/common/doors_file.h"
 #include "hidden_rooms/common/occupancy_grid.h"
+#include "hidden_rooms/common/options.h"
 #include "hidden_rooms/world/environment.h"
 
 namespace hidden_rooms::world {
@@ -21,6 +22,10 @@ struct RenderOptions {
   double margin = 1.0;       // unknown border around the environment, metres
   static constexpr double kDefaultWallThickness = 0.15;
 };
+
+// resolution, door_width and margin with the ranges renderEnvironment accepts; the optional wall_thickness is
+// not in it.
+const common::OptionTable<RenderOptions>& renderOptionTable();
 
 // Ground truth of an environment in the map frame (the map frame is the environment frame: the grid's
 // origin is its lower-left corner in environment coordinates).
