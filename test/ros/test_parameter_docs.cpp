@@ -1,6 +1,8 @@
-// docs/ros_api.md against the nodes' option tables: every parameter of a table is documented in its node's
-// section with the table's type and default, and every parameter the section documents is in a table.
+// docs/ros_api.md and the shipped node configs against the nodes' option tables: every parameter of a table is
+// documented in its node's section with the table's type and default, every parameter the section documents is in
+// a table, and every key of a shipped config is a parameter of its node with a value of the parameter's type.
 
+#include <algorithm>
 #include <cstdlib>
 #include <fstream>
 #include <map>
@@ -10,6 +12,7 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 
 #include "hidden_rooms/ros/explorer.h"
 #include "hidden_rooms/ros/map_publisher.h"
@@ -120,6 +123,42 @@ TEST(ParameterDocs, MapPublisherParametersAreDocumentedWithTheirTypesAndDefaults
 
 TEST(ParameterDocs, RoomPredictorParametersAreDocumentedWithTheirTypesAndDefaults) {
   expectDocumented("room_predictor", roomPredictorParameters());
+}
+
+// A YAML value as a parameter of `type` (OptionDescription::type) takes it.
+bool fitsType(const YAML::Node& value, const std::string& type) {
+  if (type == "[x, y, yaw]") return value.IsSequence() && (value.size() == 0 || value.size() == 3);
+  if (!value.IsScalar()) return false;
+  try {
+    if (type == "double") value.as<double>();
+    else if (type == "int") value.as<int>();
+    else if (type == "bool") value.as<bool>();
+    return true;
+  } catch (const YAML::Exception&) {
+    return false;
+  }
+}
+
+TEST(ParameterDocs, ShippedConfigsSetKnownParametersOfTheirTypes) {
+  const std::vector<std::pair<std::string, std::vector<common::OptionDescription>>> configs{
+      {"explorer.yaml", explorerParameters()},         {"simulation.yaml", simulatorParameters()},
+      {"mapper.yaml", mapperParameters()},             {"view_world.yaml", mapPublisherParameters()},
+      {"predict.yaml", roomPredictorParameters()},
+  };
+  for (const auto& [file, parameters] : configs) {
+    const YAML::Node root = YAML::LoadFile(std::string(HIDDEN_ROOMS_SOURCE_DIR) + "/config/" + file);
+    ASSERT_TRUE(root.IsMap()) << file;
+    for (const auto& entry : root) {
+      const std::string name = entry.first.as<std::string>();
+      const auto row = std::find_if(parameters.begin(), parameters.end(),
+                                    [&](const common::OptionDescription& p) { return p.name == name; });
+      if (row == parameters.end()) {
+        ADD_FAILURE() << "config/" << file << ": " << name << " is no parameter of its node";
+        continue;
+      }
+      EXPECT_TRUE(fitsType(entry.second, row->type)) << "config/" << file << ": " << name << " is no " << row->type;
+    }
+  }
 }
 
 }  // namespace
