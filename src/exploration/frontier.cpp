@@ -131,8 +131,8 @@ void validate(const BlockedPassagesOptions& options) {
   const auto require = [](bool ok, const std::string& what) {
     if (!ok) throw common::InputError("explorer options", what);
   };
-  require(options.failures >= 0, "blocked_passage_failures must be >= 0");
-  for (const double value : {options.same_place, options.same_direction, options.skip, options.length, options.radius})
+  common::validateOptions(blockedPassagesOptionTable(), options);  // failures, length, radius
+  for (const double value : {options.same_place, options.same_direction, options.skip})
     require(std::isfinite(value) && value >= 0.0, "blocked passage distances and angles must be >= 0");
   require(options.skip < options.length, "the blocked stretch must start (skip) before it ends (length)");
 }

@@ -51,7 +51,7 @@ ExplorerOptions readExplorerOptions(const ros::NodeHandle& nh) {
   readParameters(nh, exploration::frontierOptionTable(), &options.frontiers);
   readParameters(nh, exploration::pathFollowerOptionTable(), &options.follower);
   readParameters(nh, exploration::blockedPassagesOptionTable(), &options.passages);
-  exploration::validate(options.passages);
+  exploration::validate(options.passages);  // the rules between parameters
   readParameters(nh, exploration::explorationPolicyOptionTable(),
                  static_cast<exploration::ExplorationPolicyOptions*>(&options));
   readParameters(nh, explorerNodeOptionTable(), &options);

@@ -1,6 +1,5 @@
 #include "hidden_rooms/ros/map_publisher.h"
 
-#include <XmlRpcValue.h>
 #include <nav_msgs/MapMetaData.h>
 
 #include "hidden_rooms/common/input_error.h"
@@ -33,17 +32,9 @@ std::vector<common::OptionDescription> mapPublisherParameters() {
 MapPublisherOptions readMapPublisherOptions(const ros::NodeHandle& private_nh) {
   MapPublisherOptions options;
   readParameters(private_nh, mapPublisherNodeOptionTable(), &options);
-  // Text that roslaunch types as an int when it is a single door number ("3" -> 3).
-  XmlRpc::XmlRpcValue closed_doors;
-  if (private_nh.getParam("closed_doors", closed_doors) && closed_doors.getType() == XmlRpc::XmlRpcValue::TypeInt)
-    options.closed_doors = std::to_string(static_cast<int>(closed_doors));
-  else
-    readParameter(private_nh, "closed_doors", &options.closed_doors);
+  readTextParameter(private_nh, "closed_doors", &options.closed_doors);
   readParameters(private_nh, world::renderOptionTable(), &options.render);
-  // Optional: only a positive value replaces the environment's own thickness.
-  double wall_thickness = 0.0;
-  readParameter(private_nh, "wall_thickness", &wall_thickness);
-  if (wall_thickness > 0.0) options.render.wall_thickness = wall_thickness;
+  readPositiveParameter(private_nh, "wall_thickness", &options.render.wall_thickness);  // else the file's own
   if (options.map_file.empty() == options.environment.empty())
     throw common::InputError(private_nh.getNamespace(), "set exactly one of ~map_file and ~environment");
   return options;

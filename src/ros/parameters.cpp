@@ -42,4 +42,18 @@ void readParameter(const ros::NodeHandle& nh, const std::string& name, std::stri
   *value = static_cast<std::string>(parameter);
 }
 
+void readTextParameter(const ros::NodeHandle& nh, const std::string& name, std::string* value) {
+  XmlRpc::XmlRpcValue parameter;
+  if (!nh.getParam(name, parameter)) return;
+  if (parameter.getType() == XmlRpc::XmlRpcValue::TypeString) *value = static_cast<std::string>(parameter);
+  else if (parameter.getType() == XmlRpc::XmlRpcValue::TypeInt) *value = std::to_string(static_cast<int>(parameter));
+  else throw wrongType(name, "text or an integer");
+}
+
+void readPositiveParameter(const ros::NodeHandle& nh, const std::string& name, std::optional<double>* value) {
+  double number = 0.0;
+  readParameter(nh, name, &number);
+  if (number > 0.0) *value = number;
+}
+
 }  // namespace hidden_rooms

@@ -74,18 +74,6 @@ bool readPose(const ros::NodeHandle& nh, const std::string& name, common::Pose2*
   return true;
 }
 
-// A text parameter that roslaunch may have typed as a number ("3" -> 3), e.g. a single door number.
-std::string readText(const ros::NodeHandle& nh, const std::string& name, const std::string& fallback) {
-  XmlRpc::XmlRpcValue value;
-  if (!nh.getParam(name, value)) return fallback;
-  switch (value.getType()) {
-    case XmlRpc::XmlRpcValue::TypeString: return static_cast<std::string>(value);
-    case XmlRpc::XmlRpcValue::TypeInt: return std::to_string(static_cast<int>(value));
-    default:
-      throw common::InputError("~" + name, "must be text (door numbers or ids, comma-separated, or 'all')");
-  }
-}
-
 uint64_t periodInSteps(double rate, double physics_step, const std::string& name) {
   if (!std::isfinite(rate) || rate <= 0.0) throw common::InputError("~" + name, "must be positive");
   return std::max<uint64_t>(1, static_cast<uint64_t>(std::llround(1.0 / (rate * physics_step))));
@@ -130,11 +118,9 @@ std::vector<common::OptionDescription> simulatorParameters() {
 SimulatorOptions readSimulatorOptions(const ros::NodeHandle& nh) {
   SimulatorOptions options;
   readParameters(nh, simulatorNodeOptionTable(), &options);
-  options.closed_doors = readText(nh, "closed_doors", options.closed_doors);
+  readTextParameter(nh, "closed_doors", &options.closed_doors);
   readParameters(nh, simulatorRenderOptionTable(), &options.render);
-  double wall_thickness = 0.0;  // 0 (or less): the file's own
-  readParameter(nh, "wall_thickness", &wall_thickness);
-  if (wall_thickness > 0.0) options.render.wall_thickness = wall_thickness;
+  readPositiveParameter(nh, "wall_thickness", &options.render.wall_thickness);  // else the file's own
 
   simulation::SimulationOptions& simulation = options.simulation;
   readParameters(nh, simulation::simulationOptionTable(), &simulation);

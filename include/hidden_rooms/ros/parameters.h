@@ -2,6 +2,7 @@
 
 // Reading an options struct from ROS parameters through its table (hidden_rooms/common/options.h).
 
+#include <optional>
 #include <string>
 #include <type_traits>
 #include <variant>
@@ -19,6 +20,12 @@ void readParameter(const ros::NodeHandle& nh, const std::string& name, double* v
 void readParameter(const ros::NodeHandle& nh, const std::string& name, int* value);
 void readParameter(const ros::NodeHandle& nh, const std::string& name, bool* value);
 void readParameter(const ros::NodeHandle& nh, const std::string& name, std::string* value);
+// Text that roslaunch types as an integer when it is a lone number (a single door number: "3" -> 3): an integer
+// is read as its text. Throws InputError("~name", "must be text or an integer") for another type.
+void readTextParameter(const ros::NodeHandle& nh, const std::string& name, std::string* value);
+// An optional positive number (a wall thickness): set only when the parameter is set and > 0; 0 or less leaves
+// `value` as it is. Throws InputError("~name", "must be a number") for another type.
+void readPositiveParameter(const ros::NodeHandle& nh, const std::string& name, std::optional<double>* value);
 
 // Sets every field of `options` whose parameter is set (private names, ~name) and validates the table's ranges;
 // throws InputError("~name", ...) naming the first bad one.
