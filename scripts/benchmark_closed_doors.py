@@ -1,13 +1,15 @@
 #!/usr/bin/python3
 """Runs room-prediction methods on a closed-door benchmark folder and compares them with the reference.
 
-Usage: benchmark_closed_doors.py BENCH_DIR --method NAME [--methods A,B,...] [--jobs N] [--binary PATH]
-                                 [--keep DIR] [--params FILE.yaml] [--csv FILE] [--plot FILE.png]
+Usage: benchmark_closed_doors.py BENCH_DIR --method NAME [--methods A,B,...] [--part P] [--jobs N]
+                                 [--binary PATH] [--keep DIR] [--params FILE.yaml] [--csv FILE] [--plot FILE.png]
 
 For every valid case of BENCH_DIR/cases.csv it runs `predict_rooms_offline` once per method (in parallel),
 times the whole command, reads the per-door IoU from the command's metrics.yaml and computes the thesis
-implementation's IoU from reference_rooms.png vs gt_rooms.png. It prints a table by number of closed doors,
-the overall mean IoU per method and of the reference, and the time and peak memory per method.
+implementation's IoU from reference_rooms.png vs gt_rooms.png where a case has one. It prints a table by number
+of closed doors, one per environment, the overall mean IoU per method and of the reference, and the time and
+peak memory per method. Any folder in the benchmark's layout works, e.g. the cases of make_closed_door_corpus
+(whose cases.csv has a `part` column: --part validation).
 
 Peak memory is the maximum resident set size of each command as measured by `/usr/bin/time -f %M` (GNU time),
 which wraps every run. resource.getrusage(RUSAGE_CHILDREN) is not used: on Linux a child started by this
@@ -57,6 +59,7 @@ class Case:
     def __init__(self, row, bench_dir):
         self.env = row["env"]
         self.name = row["case"]
+        self.part = (row.get("part") or "").strip()
         self.folder = os.path.join(bench_dir, self.env, self.name)
         self.csv_reference_iou = parse_optional_float(row.get("reference_iou"))
         self.doors, self.doors_problem = read_door_count(os.path.join(self.folder, "doors.yaml"))
@@ -96,8 +99,8 @@ def read_door_count(path):
         return None, "%s: %s" % (path, error)
 
 
-def load_cases(bench_dir):
-    """The valid cases listed in BENCH_DIR/cases.csv."""
+def load_cases(bench_dir, part=None):
+    """The valid cases listed in BENCH_DIR/cases.csv (only those of `part` when given: its `part` column)."""
     csv_path = os.path.join(bench_dir, "cases.csv")
     if not os.path.isdir(bench_dir):
         raise BenchmarkError("benchmark folder %s does not exist" % bench_dir)
@@ -110,6 +113,12 @@ def load_cases(bench_dir):
             raise BenchmarkError("%s lacks the column(s) %s" % (csv_path, ", ".join(sorted(missing))))
         rows = list(reader)
     cases = [Case(row, bench_dir) for row in rows if (row.get("valid") or "").strip() == "1"]
+    if part:
+        parts = sorted({case.part for case in cases if case.part})
+        cases = [case for case in cases if case.part == part]
+        if not cases:
+            raise BenchmarkError("%s lists no valid case of part '%s' (its parts: %s)" % (
+                csv_path, part, ", ".join(parts) or "none, it has no part column"))
     if not cases:
         raise BenchmarkError("%s lists no valid case" % csv_path)
     return cases
@@ -144,7 +153,10 @@ def door_ious(predicted, truth, doors):
 
 
 def score_reference(case):
-    """Sets case.reference_iou (mean IoU of reference_rooms.png), or case.reference_problem."""
+    """Sets case.reference_iou (mean IoU of reference_rooms.png), or case.reference_problem; a case without
+    reference_rooms.png (a corpus of the package's own) has neither."""
+    if not os.path.exists(case.path("reference_rooms.png")):
+        return
     try:
         truth = read_label_image(case.path("gt_rooms.png"))
         reference = read_label_image(case.path("reference_rooms.png"))
@@ -327,6 +339,30 @@ def print_table(cases, methods, runs):
     print()
 
 
+def print_environments(cases, methods, runs):
+    """Mean IoU per environment: a method that wins on average but collapses on some buildings shows it."""
+    environments = sorted({case.env for case in cases}, key=str.lower)
+    width = max(10, *(len(method) + 1 for method in methods))
+    name_width = max(len("environment"), *(len(env) for env in environments))
+    with_parts = any(case.part for case in cases)
+    header = "environment".ljust(name_width) + ("  part      " if with_parts else "") + "  cases" + \
+        "".join(method.rjust(width) for method in methods) + "reference".rjust(width)
+    print("Mean IoU per environment")
+    print(header)
+    print("-" * len(header))
+    for env in environments:
+        indices = [i for i, case in enumerate(cases) if case.env == env]
+        line = env.ljust(name_width)
+        if with_parts:
+            line += "  " + cases[indices[0]].part.ljust(10)
+        line += "  %5d" % len(indices)
+        for method in methods:
+            line += format_score(mean_or_none([runs[method][i].mean_iou for i in indices]), width)
+        line += format_score(mean_or_none([cases[i].reference_iou for i in indices]), width)
+        print(line)
+    print()
+
+
 def print_overall(cases, methods, runs):
     """Overall mean IoU per method and of the reference, and the agreement with cases.csv."""
     with_reference = [i for i, case in enumerate(cases) if case.reference_iou is not None]
@@ -347,7 +383,7 @@ def print_overall(cases, methods, runs):
         print("  reference vs cases.csv reference_iou: max difference %.4f over %d cases" % (
             max(differences), len(differences)))
     for case in cases:
-        if case.reference_iou is None:
+        if case.reference_problem is not None:
             print("  no reference score for %s: %s" % (case.label, case.reference_problem))
     print()
 
@@ -433,6 +469,7 @@ def parse_arguments(argv):
     parser = argparse.ArgumentParser(
         description="Benchmark room-prediction methods on a closed-door benchmark folder.")
     parser.add_argument("bench_dir", metavar="BENCH_DIR", help="benchmark folder with cases.csv")
+    parser.add_argument("--part", help="only the cases whose cases.csv `part` is this (e.g. validation)")
     parser.add_argument("--method", action="append", default=[], help="a prediction method (repeatable)")
     parser.add_argument("--methods", default="", help="comma-separated methods, printed side by side")
     parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="parallel runs (default: cores)")
@@ -462,7 +499,7 @@ def parse_arguments(argv):
 def main(argv=None):
     args = parse_arguments(argv)
     try:
-        cases = load_cases(args.bench_dir)
+        cases = load_cases(args.bench_dir, args.part)
         binary = find_binary(args.binary)
         available = known_methods(binary)
         unknown = [method for method in args.method_list if available is not None and method not in available]
@@ -493,6 +530,7 @@ def main(argv=None):
 
     print()
     print_table(cases, args.method_list, runs)
+    print_environments(cases, args.method_list, runs)
     print_overall(cases, args.method_list, runs)
     print_resources(args.method_list, runs)
     failures = print_failures(args.method_list, runs)

@@ -48,6 +48,13 @@ MapDoor readDoor(const YAML::Node& node, size_t index, const std::string& source
   if (orientation == "O") door.orientation = DoorOrientation::kAlongX;
   else if (orientation == "V") door.orientation = DoorOrientation::kAlongY;
   else throw InputError(source, where(index) + ".orientation is '" + orientation + "' (O or V)");
+  if (const YAML::Node transform = node["map_from_world"]) {
+    if (!transform.IsSequence() || transform.size() != 3)
+      throw InputError(source, where(index) + ".map_from_world must be [x, y, yaw]");
+    door.map_from_world = Pose2{finiteNumber(transform[0], where(index) + ".map_from_world[0]", source),
+                                finiteNumber(transform[1], where(index) + ".map_from_world[1]", source),
+                                finiteNumber(transform[2], where(index) + ".map_from_world[2]", source)};
+  }
   return door;
 }
 
@@ -91,6 +98,9 @@ void saveDoors(const DoorsFile& doors, const std::string& path) {
         << door.position.y() << YAML::EndSeq;
     out << YAML::Key << "width" << YAML::Value << door.width;
     out << YAML::Key << "orientation" << YAML::Value << toString(door.orientation);
+    if (door.map_from_world)
+      out << YAML::Key << "map_from_world" << YAML::Value << YAML::Flow << YAML::BeginSeq << door.map_from_world->x
+          << door.map_from_world->y << door.map_from_world->yaw << YAML::EndSeq;
     out << YAML::EndMap;
   }
   out << YAML::EndSeq << YAML::EndMap;

@@ -169,7 +169,7 @@ OccupancyGrid loadMap(const std::string& yaml_path) {
   return gridFromImage(image, metadata);
 }
 
-std::string saveMap(const OccupancyGrid& grid, const std::string& prefix) {
+std::string saveMap(const OccupancyGrid& grid, const std::string& prefix, const std::string& image_extension) {
   if (grid.empty()) throw InputError(prefix, "cannot save an empty map");
   cv::Mat1b image(grid.cells.size());
   for (int row = 0; row < image.rows; ++row)
@@ -180,12 +180,12 @@ std::string saveMap(const OccupancyGrid& grid, const std::string& prefix) {
       else image(row, col) = 205;
     }
   const std::filesystem::path yaml_path = prefix + ".yaml";
-  const std::filesystem::path pgm_path = prefix + ".pgm";
-  writeImage(pgm_path.string(), image);
+  const std::filesystem::path image_path = prefix + image_extension;
+  writeImage(image_path.string(), image);
 
   YAML::Emitter out;
   out << YAML::BeginMap;
-  out << YAML::Key << "image" << YAML::Value << pgm_path.filename().string();
+  out << YAML::Key << "image" << YAML::Value << image_path.filename().string();
   out << YAML::Key << "resolution" << YAML::Value << grid.resolution;
   out << YAML::Key << "origin" << YAML::Value << YAML::Flow << YAML::BeginSeq << grid.origin.x() << grid.origin.y()
       << 0.0 << YAML::EndSeq;

@@ -37,6 +37,18 @@ std::vector<int> doorIndices(const world::Environment& environment, const std::v
   return indices;
 }
 
+// Per label k = 1..outlines.size(): area of the true room's cells / area of its outline.
+std::vector<double> roomCoverage(const cv::Mat1w& true_rooms, double resolution,
+                                 const std::vector<const common::Polygon*>& outlines) {
+  std::vector<double> coverage;
+  for (size_t k = 0; k < outlines.size(); ++k) {
+    const double outline_area = common::area(*outlines[k]);
+    const double cells = cv::countNonZero(true_rooms == static_cast<uint16_t>(k + 1));
+    coverage.push_back(outline_area > 0.0 ? cells * resolution * resolution / outline_area : 0.0);
+  }
+  return coverage;
+}
+
 double hiddenPercent(const cv::Mat1w& true_rooms, const cv::Mat1b& complete_free) {
   const int free_cells = cv::countNonZero(complete_free);
   return free_cells > 0 ? 100.0 * cv::countNonZero(true_rooms) / free_cells : 0.0;
@@ -55,6 +67,11 @@ BatchCase makeBatchCase(const world::Environment& environment, const std::vector
   const cv::Mat1b complete_free = rendered.map.cells == common::OccupancyGrid::kFree;
   result.input = world::hideClosedRooms(environment, rendered);
   result.hidden_percent = hiddenPercent(result.input.true_rooms, complete_free);
+  std::vector<const common::Polygon*> outlines;
+  for (const common::MapDoor& door : result.input.closed_doors.doors)
+    outlines.push_back(
+        &environment.spaces[world::roomBehindDoor(environment, environment.findDoor(std::to_string(door.id)))].outline);
+  result.room_coverage = roomCoverage(result.input.true_rooms, rendered.map.resolution, outlines);
   result.seconds = secondsSince(start);
   return result;
 }
@@ -93,11 +110,16 @@ BatchCase makeBatchCaseFromMap(const world::Environment& environment, const comm
   const double angle = std::atan2(s_sin, s_cos);
   Eigen::Matrix2d rotation;
   rotation << std::cos(angle), -std::sin(angle), std::sin(angle), std::cos(angle);
-  const auto toMap = [&](const common::Point2& p) -> common::Point2 { return rotation * (p - mean_env) + mean_map; };
-  const auto toCells = [&](const common::Polygon& polygon) {
+  const common::Point2 offset = mean_map - rotation * mean_env;
+  const common::Pose2 fitted{offset.x(), offset.y(), angle};
+  // Each closed room is placed by its door's own transform when the doors file has one (an explored map drifts:
+  // the room lies where the map shows its door's surroundings), else by the fit.
+  std::map<int, common::Pose2> map_from_world;
+  for (const common::MapDoor& door : doors_in_map.doors) map_from_world[door.id] = door.map_from_world.value_or(fitted);
+  const auto toCells = [&](const common::Polygon& polygon, const common::Pose2& transform) {
     std::vector<cv::Point> points;
     for (const common::Point2& p : polygon) {
-      const common::Point2 image = complete_map.toImage(toMap(p));
+      const common::Point2 image = complete_map.toImage(common::transformPoint(transform, p));
       points.emplace_back(static_cast<int>(std::floor(image.x())), static_cast<int>(std::floor(image.y())));
     }
     return points;
@@ -117,14 +139,17 @@ BatchCase makeBatchCaseFromMap(const world::Environment& environment, const comm
   const int margin_cells = static_cast<int>(std::ceil(wall_margin / complete_map.resolution));
   const cv::Mat kernel =
       cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * margin_cells + 1, 2 * margin_cells + 1));
+  std::vector<const common::Polygon*> outlines;
   for (size_t k = 0; k < ordered.size(); ++k) {
     const world::Door& door = environment.doors[ordered[k]];
     const int room = world::roomBehindDoor(environment, ordered[k]);
     if (room < 0)
       throw common::InputError(
           "closed doors", "door " + std::to_string(door.number) + " is not closable: no room lies behind it alone");
+    outlines.push_back(&environment.spaces[room].outline);
     cv::Mat1b outline = cv::Mat1b::zeros(complete_map.cells.size());
-    const std::vector<std::vector<cv::Point>> polygons{toCells(environment.spaces[room].outline)};
+    const common::Pose2& transform = map_from_world[door.number];
+    const std::vector<std::vector<cv::Point>> polygons{toCells(environment.spaces[room].outline, transform)};
     cv::fillPoly(outline, polygons, cv::Scalar(255));
     hidden.true_rooms.setTo(static_cast<uint16_t>(k + 1), outline & complete_free);
     cv::Mat1b grown;
@@ -134,7 +159,7 @@ BatchCase makeBatchCaseFromMap(const world::Environment& environment, const comm
     closed.id = door.number;
     closed.position = in_map[door.number];
     closed.width = door_width;
-    const double wall_angle = door.wall_angle + angle;
+    const double wall_angle = door.wall_angle + transform.yaw;
     closed.orientation = std::abs(std::cos(wall_angle)) >= std::abs(std::sin(wall_angle))
                              ? common::DoorOrientation::kAlongX
                              : common::DoorOrientation::kAlongY;
@@ -160,6 +185,7 @@ BatchCase makeBatchCaseFromMap(const world::Environment& environment, const comm
   }
   hidden.true_rooms.setTo(0, hidden.map.cells == common::OccupancyGrid::kOccupied);  // the doors' walls
   result.hidden_percent = hiddenPercent(hidden.true_rooms, complete_free);
+  result.room_coverage = roomCoverage(hidden.true_rooms, complete_map.resolution, outlines);
   result.seconds = secondsSince(start);
   return result;
 }

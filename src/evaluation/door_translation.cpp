@@ -45,12 +45,14 @@ DoorInMap translateDoor(const common::Point2& door_world, double wall_angle_worl
   door.wall_angle = halfTurnAngle(wall_angle_world + common::wrapAngle(robot_map.yaw - robot_world.pose.yaw));
   door.time = robot_world.time;
   door.robot_distance = closest_distance;
+  door.map_from_world = common::composePoses(robot_map, common::invertPose(robot_world.pose));
   return door;
 }
 
 common::DoorsFile translateDoors(const world::Environment& environment, const std::vector<int>& door_indices,
                                  const std::vector<common::TimedPose>& truth,
-                                 const std::vector<common::TimedPose>& estimate, double door_width) {
+                                 const std::vector<common::TimedPose>& estimate, double door_width,
+                                 bool with_map_from_world) {
   common::DoorsFile doors;
   doors.frame = "map";
   for (int index : door_indices) {
@@ -65,6 +67,7 @@ common::DoorsFile translateDoors(const world::Environment& environment, const st
     map_door.orientation = std::abs(std::cos(in_map.wall_angle)) >= std::abs(std::sin(in_map.wall_angle))
                                ? common::DoorOrientation::kAlongX
                                : common::DoorOrientation::kAlongY;
+    if (with_map_from_world) map_door.map_from_world = in_map.map_from_world;
     doors.doors.push_back(map_door);
   }
   return doors;

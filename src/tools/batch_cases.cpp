@@ -119,8 +119,9 @@ int run(int argc, char** argv) {
       "Methods: " + methods_known + "\n"
       "Case K closes the first K doors of the sequence, erases the rooms behind them, paints\n"
       "the doors as walls, runs every method and scores it against the true rooms; prints one\n"
-      "JSON line per case: closed_doors, door_ids, hidden_percent, case_seconds and per method\n"
-      "mean_iou, iou_total, seconds, not_placed, problem.";
+      "JSON line per case: closed_doors, door_ids, hidden_percent, room_coverage (per door: the true\n"
+      "room's area / its outline's), case_seconds and per method mean_iou, iou_total, seconds,\n"
+      "not_placed, problem. With --write-cases, --methods may be left out.";
   if (!common::parseCommandLine(argc, argv, usage, options, positional, &values))
     return common::kExitOk;
 
@@ -142,7 +143,8 @@ int run(int argc, char** argv) {
                                std::to_string(k) + " doors but the sequence has " + std::to_string(sequence.size()));
   std::vector<std::unique_ptr<prediction::RoomPredictor>> methods;
   for (const std::string& name : splitList(methods_text)) methods.push_back(prediction::makeRoomPredictor(name));
-  if (methods.empty()) throw common::InputError("--methods", "no method given");
+  if (methods.empty() && write_dir.empty())
+    throw common::InputError("--methods", "no method given (and no --write-cases: nothing to do)");
   std::map<std::string, double> parameters;
   if (!params_path.empty()) parameters = prediction::loadParameterFile(params_path);
   for (const auto& method : methods) prediction::resolveParameters(*method, parameters);  // unknown names fail up front
@@ -169,6 +171,7 @@ int run(int argc, char** argv) {
     std::ostringstream line;
     line << "{\"closed_doors\": " << k << ", \"door_ids\": " << jsonList(closed)
          << ", \"hidden_percent\": " << jsonNumber(batch_case.hidden_percent)
+         << ", \"room_coverage\": " << jsonList(batch_case.room_coverage)
          << ", \"case_seconds\": " << jsonNumber(batch_case.seconds) << ", \"methods\": {";
     for (size_t m = 0; m < methods.size(); ++m) {
       const evaluation::MethodOutcome outcome = evaluation::runMethodOnCase(*methods[m], batch_case, parameters);

@@ -44,6 +44,14 @@ TEST(DoorsFile, SaveThenLoadRoundTrips) {
   EXPECT_EQ(loaded.doors[0].orientation, DoorOrientation::kAlongY);
   EXPECT_LT((loaded.doors[0].position - Point2(1.5, -2.25)).norm(), 1e-12);
   EXPECT_DOUBLE_EQ(loaded.doors[1].width, 1.2);
+  EXPECT_FALSE(loaded.doors[0].map_from_world);
+  doors.doors[1].map_from_world = Pose2{0.5, -1.25, 0.03};
+  saveDoors(doors, path);
+  const DoorsFile with_transform = loadDoors(path);
+  ASSERT_TRUE(with_transform.doors[1].map_from_world);
+  EXPECT_DOUBLE_EQ(with_transform.doors[1].map_from_world->y, -1.25);
+  EXPECT_DOUBLE_EQ(with_transform.doors[1].map_from_world->yaw, 0.03);
+  EXPECT_FALSE(with_transform.doors[0].map_from_world);
   saveDoors(DoorsFile(), path);
   EXPECT_TRUE(loadDoors(path).doors.empty());
 }
@@ -80,6 +88,10 @@ TEST(DoorsFile, BadDoorsFilesGiveClearErrors) {
   expectError("doors:\n- {id: 1, position: [1, 2], width: -1, orientation: O}\n", "width must be positive");
   expectError("doors:\n- {id: 1, position: [1, 2], width: 0.9, orientation: X}\n", "(O or V)");
   expectError("doors:\n" + door + door, "used twice");
+  expectError("doors:\n- {id: 1, position: [1, 2], width: 0.9, orientation: O, map_from_world: [1, 2]}\n",
+              "map_from_world must be [x, y, yaw]");
+  expectError("doors:\n- {id: 1, position: [1, 2], width: 0.9, orientation: O, map_from_world: [1, 2, .inf]}\n",
+              "map_from_world[2] is not finite");
   EXPECT_THROW(loadDoors("/nonexistent/doors.yaml"), InputError);
 }
 

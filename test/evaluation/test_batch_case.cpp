@@ -92,6 +92,24 @@ TEST(BatchCase, FromACompleteMapMatchesTheRendering) {
   const MethodOutcome outcome = runMethodOnCase(*prediction::makeRoomPredictor("unstructured"), from_map);
   EXPECT_GT(outcome.scores.mean_iou, 0.5) << outcome.problem;
 
+  // A door with its own transform places its room by it: here the room behind door 2 is drawn 1 m further in x
+  // than the door-centre fit puts it.
+  common::DoorsFile drifted = doors_in_map;
+  drifted.doors[1].map_from_world = common::Pose2{4.0, -2.0, 0.0};
+  const BatchCase by_door = makeBatchCaseFromMap(environment, shifted, drifted, {2});
+  const cv::Mat1b moved = by_door.input.true_rooms == 1;
+  cv::Mat1b expected;
+  const int cells = static_cast<int>(std::lround(1.0 / shifted.resolution));
+  cv::Mat1b shifted_room = cv::Mat1b::zeros(a.size());
+  a(cv::Rect(0, 0, a.cols - cells, a.rows)).copyTo(shifted_room(cv::Rect(cells, 0, a.cols - cells, a.rows)));
+  const cv::Mat1b complete_free = shifted.cells == common::OccupancyGrid::kFree;
+  expected = shifted_room & complete_free;
+  EXPECT_GT(cv::countNonZero(moved & expected), 0.9 * cv::countNonZero(moved | expected));
+  ASSERT_EQ(by_door.room_coverage.size(), 1u);
+  ASSERT_EQ(from_map.room_coverage.size(), 1u);
+  EXPECT_GT(from_map.room_coverage[0], 0.85);  // the true room is (nearly) all of the outline
+  EXPECT_LE(from_map.room_coverage[0], 1.0);
+
   common::DoorsFile one_door;
   one_door.doors.push_back(doors_in_map.doors[1]);
   EXPECT_THROW(makeBatchCaseFromMap(environment, shifted, one_door, {2}), common::InputError);

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -18,13 +19,16 @@ struct MapDoor {
   Point2 position = Point2::Zero();  // metres, in the file's frame
   double width = 0.9;                // metres
   DoorOrientation orientation = DoorOrientation::kAlongX;
+  // Optional: where a simulated world lies in this map at the door (the rigid transform map <- world that carried
+  // the door over, docs/method.md#closed-doors-in-the-map), written for explored maps of known environments.
+  std::optional<Pose2> map_from_world;
 };
 
 // The package's closed-doors file (doors.yaml):
 //   frame: map
 //   doors:
 //     - {id: 1, position: [x, y], width: 0.9, orientation: O}   # O: door line along x, V: along y
-// Unknown keys are ignored.
+// and optionally `map_from_world: [x, y, yaw]` per door. Unknown keys are ignored.
 struct DoorsFile {
   std::string frame = "map";
   std::vector<MapDoor> doors;

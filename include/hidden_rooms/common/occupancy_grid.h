@@ -59,8 +59,9 @@ OccupancyGrid loadMap(const std::string& yaml_path);
 OccupancyGrid gridFromImage(const cv::Mat& image, const MapMetadata& metadata);
 
 // Writes `PREFIX.yaml` and `PREFIX.pgm` as map_saver does (trinary: 254 free, 0 occupied, 205 unknown;
-// cells <= 19 are free, >= 65 occupied). Returns the yaml path. Throws InputError when it cannot write.
-std::string saveMap(const OccupancyGrid& grid, const std::string& prefix);
+// cells <= 19 are free, >= 65 occupied), the image as `PREFIX` + `image_extension` (".png": compressed). Returns
+// the yaml path. Throws InputError when it cannot write.
+std::string saveMap(const OccupancyGrid& grid, const std::string& prefix, const std::string& image_extension = ".pgm");
 
 // Free cells reachable from (col, row) through free cells (4-connected), as a 0/255 mask of the grid's size; all
 // zero when (col, row) is outside the grid or not free.

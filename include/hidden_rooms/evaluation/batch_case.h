@@ -18,6 +18,9 @@ struct BatchCase {
   std::vector<int> closed_door_numbers;  // as given (closing order), 1-based door numbers
   world::HiddenRoomsCase input;          // map with the rooms erased, doors (environment order), true rooms
   double hidden_percent = 0.0;           // 100 * true room cells / free cells of the complete map
+  // Per closed door (doors file order): the true room's area in the map / the area of its outline. Below 1 where
+  // the explored map shows only part of the room (and by the walls' half thickness); from a rendering ~1.
+  std::vector<double> room_coverage;
   double seconds = 0.0;                  // time to build the case
 };
 
@@ -30,7 +33,8 @@ BatchCase makeBatchCase(const world::Environment& environment, const std::vector
 // The same from a complete map that is not the rendering (e.g. a map built by exploration): `doors_in_map`
 // gives the position of every door of the environment in the map's frame, by door number (at least the closed
 // doors, and two doors in all). The environment is placed in the map by the least-squares rigid
-// transform of the door centres; each closed room's outline, grown by `wall_margin` metres, is erased to
+// transform of the door centres, each closed room by its door's `map_from_world` where the file has one (an
+// explored map's drift); each closed room's outline, grown by `wall_margin` metres, is erased to
 // unknown (its true room: the map's free cells inside the outline, before erasing), and each closed door is
 // painted as a wall across its width. Throws InputError when the doors are missing or do not fit.
 BatchCase makeBatchCaseFromMap(const world::Environment& environment, const common::OccupancyGrid& complete_map,

@@ -20,6 +20,9 @@ struct DoorInMap {
   double wall_angle = 0.0;           // direction of the door's wall in the map frame, radians in [0, pi)
   double time = 0.0;                 // when the robot was closest to the door
   double robot_distance = 0.0;       // that closest distance, metres
+  // The rigid transform that carried the door over, M_r(t_min) * GT_r(t_min)^-1: the world placed in the map as
+  // the map shows the door's surroundings.
+  common::Pose2 map_from_world;
 };
 
 // The thesis's translation made rigid: the robot pose closest to the door (t_min) is looked up in both
@@ -30,10 +33,12 @@ DoorInMap translateDoor(const common::Point2& door_world, double wall_angle_worl
                         const std::vector<common::TimedPose>& truth, const std::vector<common::TimedPose>& estimate);
 
 // The given doors of `environment` (indices) as a doors.yaml in the map frame: id = the door's number, width
-// `door_width`, orientation from the translated wall direction (O when it runs closer to x than to y).
+// `door_width`, orientation from the translated wall direction (O when it runs closer to x than to y), and with
+// `with_map_from_world` the transform that carried each door over.
 common::DoorsFile translateDoors(const world::Environment& environment, const std::vector<int>& door_indices,
                                  const std::vector<common::TimedPose>& truth,
-                                 const std::vector<common::TimedPose>& estimate, double door_width);
+                                 const std::vector<common::TimedPose>& estimate, double door_width,
+                                 bool with_map_from_world = false);
 
 // The rigid transform world <- map that best overlays the estimated positions on the true ones at the same
 // times (least squares over the estimate's poses, Umeyama without scale). Used to score a map against its
