@@ -37,14 +37,15 @@ std::vector<int> doorIndices(const world::Environment& environment, const std::v
   return indices;
 }
 
-// Per label k = 1..outlines.size(): area of the true room's cells / area of its outline.
-std::vector<double> roomCoverage(const cv::Mat1w& true_rooms, double resolution,
-                                 const std::vector<const common::Polygon*>& outlines) {
+// Per label k = 1..rooms.size(): the true room's area / the free area of space rooms[k-1] in `rendered`.
+std::vector<double> roomCoverage(const cv::Mat1w& true_rooms, double resolution, const std::vector<int>& rooms,
+                                 const world::RenderedEnvironment& rendered) {
   std::vector<double> coverage;
-  for (size_t k = 0; k < outlines.size(); ++k) {
-    const double outline_area = common::area(*outlines[k]);
-    const double cells = cv::countNonZero(true_rooms == static_cast<uint16_t>(k + 1));
-    coverage.push_back(outline_area > 0.0 ? cells * resolution * resolution / outline_area : 0.0);
+  const double rendered_cell = rendered.map.resolution * rendered.map.resolution;
+  for (size_t k = 0; k < rooms.size(); ++k) {
+    const double free_area = cv::countNonZero(rendered.space_labels == static_cast<uint16_t>(rooms[k] + 1)) * rendered_cell;
+    const double area = cv::countNonZero(true_rooms == static_cast<uint16_t>(k + 1)) * resolution * resolution;
+    coverage.push_back(free_area > 0.0 ? area / free_area : 0.0);
   }
   return coverage;
 }
@@ -67,11 +68,11 @@ BatchCase makeBatchCase(const world::Environment& environment, const std::vector
   const cv::Mat1b complete_free = rendered.map.cells == common::OccupancyGrid::kFree;
   result.input = world::hideClosedRooms(environment, rendered);
   result.hidden_percent = hiddenPercent(result.input.true_rooms, complete_free);
-  std::vector<const common::Polygon*> outlines;
+  std::vector<int> rooms;
   for (const common::MapDoor& door : result.input.closed_doors.doors)
-    outlines.push_back(
-        &environment.spaces[world::roomBehindDoor(environment, environment.findDoor(std::to_string(door.id)))].outline);
-  result.room_coverage = roomCoverage(result.input.true_rooms, rendered.map.resolution, outlines);
+    rooms.push_back(world::roomBehindDoor(environment, environment.findDoor(std::to_string(door.id))));
+  const world::RenderedEnvironment all_open = world::renderEnvironment(environment, {}, options);
+  result.room_coverage = roomCoverage(result.input.true_rooms, rendered.map.resolution, rooms, all_open);
   result.seconds = secondsSince(start);
   return result;
 }
@@ -139,14 +140,14 @@ BatchCase makeBatchCaseFromMap(const world::Environment& environment, const comm
   const int margin_cells = static_cast<int>(std::ceil(wall_margin / complete_map.resolution));
   const cv::Mat kernel =
       cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * margin_cells + 1, 2 * margin_cells + 1));
-  std::vector<const common::Polygon*> outlines;
+  std::vector<int> rooms;
   for (size_t k = 0; k < ordered.size(); ++k) {
     const world::Door& door = environment.doors[ordered[k]];
     const int room = world::roomBehindDoor(environment, ordered[k]);
     if (room < 0)
       throw common::InputError(
           "closed doors", "door " + std::to_string(door.number) + " is not closable: no room lies behind it alone");
-    outlines.push_back(&environment.spaces[room].outline);
+    rooms.push_back(room);
     cv::Mat1b outline = cv::Mat1b::zeros(complete_map.cells.size());
     const common::Pose2& transform = map_from_world[door.number];
     const std::vector<std::vector<cv::Point>> polygons{toCells(environment.spaces[room].outline, transform)};
@@ -185,7 +186,11 @@ BatchCase makeBatchCaseFromMap(const world::Environment& environment, const comm
   }
   hidden.true_rooms.setTo(0, hidden.map.cells == common::OccupancyGrid::kOccupied);  // the doors' walls
   result.hidden_percent = hiddenPercent(hidden.true_rooms, complete_free);
-  result.room_coverage = roomCoverage(hidden.true_rooms, complete_map.resolution, outlines);
+  world::RenderOptions render_options;
+  render_options.resolution = complete_map.resolution;
+  render_options.door_width = door_width;
+  result.room_coverage =
+      roomCoverage(hidden.true_rooms, complete_map.resolution, rooms, world::renderEnvironment(environment, {}, render_options));
   result.seconds = secondsSince(start);
   return result;
 }

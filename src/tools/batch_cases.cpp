@@ -120,8 +120,8 @@ int run(int argc, char** argv) {
       "Case K closes the first K doors of the sequence, erases the rooms behind them, paints\n"
       "the doors as walls, runs every method and scores it against the true rooms; prints one\n"
       "JSON line per case: closed_doors, door_ids, hidden_percent, room_coverage (per door: the true\n"
-      "room's area / its outline's), case_seconds and per method mean_iou, iou_total, seconds,\n"
-      "not_placed, problem. With --write-cases, --methods may be left out.";
+      "room's area / its free area in the rendering), case_seconds and per method mean_iou, iou_total, seconds,\n"
+      "not_placed, problem. Without --methods it only builds (and writes) the cases.";
   if (!common::parseCommandLine(argc, argv, usage, options, positional, &values))
     return common::kExitOk;
 
@@ -143,8 +143,6 @@ int run(int argc, char** argv) {
                                std::to_string(k) + " doors but the sequence has " + std::to_string(sequence.size()));
   std::vector<std::unique_ptr<prediction::RoomPredictor>> methods;
   for (const std::string& name : splitList(methods_text)) methods.push_back(prediction::makeRoomPredictor(name));
-  if (methods.empty() && write_dir.empty())
-    throw common::InputError("--methods", "no method given (and no --write-cases: nothing to do)");
   std::map<std::string, double> parameters;
   if (!params_path.empty()) parameters = prediction::loadParameterFile(params_path);
   for (const auto& method : methods) prediction::resolveParameters(*method, parameters);  // unknown names fail up front
