@@ -350,63 +350,44 @@ void clipToKnownOutline(const cv::Mat1b& known, const cv::Point& door, int reach
 }
 
 double dominantWallAngle(const common::OccupancyGrid& map) {
-  // Only around the occupied cells (the blur and the gradients vanish 20 pixels away from them).
-  const cv::Mat1b occupied_cells = map.cells >= kOccupiedFrom;
-  const cv::Rect around = cv::boundingRect(occupied_cells);
-  if (around.area() == 0) return 0.0;
-  const cv::Rect crop = cv::Rect(around.x - 20, around.y - 20, around.width + 40, around.height + 40) &
-                        cv::Rect(0, 0, map.width(), map.height());
-  // Gradient directions, weighted by their magnitude, into a histogram modulo 90 degrees (walls run perpendicular
-  // to their gradients). The image is worked through in strips of rows, each with enough rows of context on both
-  // sides for the blur and the Sobel kernels, so that the working images stay small: the same values as on the
-  // whole image at once.
-  constexpr double kBlurSigma = 2.5;
-  constexpr int kSobelSize = 5;
-  constexpr int kStripRows = 64;
-  const int context = static_cast<int>(std::lround(4 * kBlurSigma)) + kSobelSize / 2 + 2;
-  constexpr int kBins = 180;  // half-degree bins over 90 degrees
-  std::vector<double> histogram(kBins, 0.0);
-  const cv::Mat1b cells = occupied_cells(crop);
-  cv::Mat1f occupied, gx, gy, magnitude, direction;  // direction in [0, 2 pi)
-  for (int top = 0; top < cells.rows; top += kStripRows) {
-    const int bottom = std::min(cells.rows, top + kStripRows);
-    const int first = std::max(0, top - context), last = std::min(cells.rows, bottom + context);
-    cells.rowRange(first, last).convertTo(occupied, CV_32F, 1.0 / 255.0);
-    cv::GaussianBlur(occupied, occupied, cv::Size(0, 0), kBlurSigma);
-    cv::Sobel(occupied, gx, CV_32F, 1, 0, kSobelSize);
-    cv::Sobel(occupied, gy, CV_32F, 0, 1, kSobelSize);
-    const cv::Range strip(top - first, bottom - first);
-    cv::cartToPolar(gx.rowRange(strip), gy.rowRange(strip), magnitude, direction);
-    for (int r = 0; r < magnitude.rows; ++r) {
-      const float* m = magnitude.ptr<float>(r);
-      const float* d = direction.ptr<float>(r);
-      for (int c = 0; c < magnitude.cols; ++c) {
-        if (m[c] < 1e-3f) continue;
-        const double angle = std::fmod(static_cast<double>(d[c]), CV_PI / 2.0);
-        const int bin = std::clamp(static_cast<int>(angle / (CV_PI / 2.0) * kBins), 0, kBins - 1);
-        histogram[bin] += m[c];
-      }
+  // The projection profiles of the wall pixels: turned by the walls' angle, the pixels of each wall fall into a
+  // few rows or columns, so the profiles along both axes are sharpest (their sums of squared counts largest).
+  // Robust to the staircase a turned wall is rasterized into, which biases gradient directions towards 0.
+  std::vector<cv::Point> cells;
+  cv::findNonZero(map.cells >= kOccupiedFrom, cells);
+  if (cells.empty()) return 0.0;
+  constexpr size_t kMaxPoints = 20000;  // evenly thinned beyond this: the profiles keep their shape
+  const size_t stride = cells.size() / kMaxPoints + 1;
+  std::vector<cv::Point2d> points;
+  for (size_t k = 0; k < cells.size(); k += stride) points.emplace_back(cells[k].x, cells[k].y);
+  const double diagonal = std::hypot(map.width(), map.height());
+  const int bins = static_cast<int>(std::ceil(2.0 * diagonal)) + 2;
+  std::vector<int> along(bins), across(bins);
+  const auto sharpness = [&](double angle) {
+    std::fill(along.begin(), along.end(), 0);
+    std::fill(across.begin(), across.end(), 0);
+    const double c = std::cos(angle), s = std::sin(angle);
+    for (const cv::Point2d& p : points) {
+      ++along[static_cast<int>(std::floor(c * p.x + s * p.y + diagonal))];
+      ++across[static_cast<int>(std::floor(-s * p.x + c * p.y + diagonal))];
+    }
+    double sum = 0.0;
+    for (int b = 0; b < bins; ++b) sum += double(along[b]) * along[b] + double(across[b]) * across[b];
+    return sum;
+  };
+  // Coarse search over the 90 degree period, then finer around the best angle.
+  const double degree = CV_PI / 180.0;
+  double best = 0.0, best_value = -1.0;
+  for (double step : {1.0 * degree, 0.1 * degree, 0.02 * degree}) {
+    const double centre = best, span = best_value < 0.0 ? 45.0 * degree : 10.0 * step;
+    for (double angle = centre - span; angle < centre + span; angle += step) {
+      const double value = sharpness(angle);
+      if (value > best_value) best_value = value, best = angle;
     }
   }
-  int best = 0;
-  double best_value = -1.0;
-  for (int b = 0; b < kBins; ++b) {
-    double value = 0.0;
-    for (int k = -3; k <= 3; ++k) value += histogram[(b + k + kBins) % kBins];
-    if (value > best_value) best_value = value, best = b;
-  }
-  if (best_value <= 0.0) return 0.0;
-  // Weighted mean around the peak (circular over the 90 degree period).
-  double sum = 0.0, weight = 0.0;
-  for (int k = -6; k <= 6; ++k) {
-    const double w = histogram[(best + k + kBins) % kBins];
-    sum += w * (best + k + 0.5);
-    weight += w;
-  }
-  double angle = (sum / weight) / kBins * (CV_PI / 2.0);
-  angle = std::fmod(angle + CV_PI, CV_PI / 2.0);
-  if (angle >= CV_PI / 4.0) angle -= CV_PI / 2.0;
-  return angle;
+  best = std::fmod(best + CV_PI, CV_PI / 2.0);
+  if (best >= CV_PI / 4.0) best -= CV_PI / 2.0;
+  return best;
 }
 
 double unseenWallThickness(const common::OccupancyGrid& map) { return unseenWallMetres(statesOf(map), map.resolution); }
@@ -423,7 +404,7 @@ const common::OptionTable<DefaultOptions>& defaultOptionTable() {
       {"default_neighbour_reach", &O::neighbour_reach,
        "m: how far along the wall explored neighbours are looked for", common::atLeast(0)},
       {"default_min_depth", &O::min_depth, "m: smallest depth taken from the square prior", common::atLeast(0)},
-      {"default_min_rotation", &O::min_rotation, "degrees: smaller dominant angles are not corrected",
+      {"default_min_rotation", &O::min_rotation, "degrees: maps turned less are not predicted turned straight",
        common::atLeast(0)},
       {"default_grown_area_ratio", &O::grown_area_ratio,
        "grown rooms less than this many times the rectangle give way", common::atLeast(0)},
@@ -447,38 +428,9 @@ std::map<std::string, double> DefaultPredictor::defaultParameters() const {
 
 namespace {
 
-// The image the rectangles are built in: the map's states, turned straight when the map is rotated.
-struct WorkingImage {
-  bool rotated = false;                   // the dominant wall angle is at least min_rotation
-  cv::Matx23d forward{1, 0, 0, 0, 1, 0};  // map pixel -> working pixel (identity unless rotated)
-  cv::Mat1b states;                       // statesOf the map in the working frame, kUnknownPx past the map
-};
-
-// Step 1, orientation: the map's states turned by -angle about their centre, on an image large enough for the
-// whole turned map (plus one pixel each side), when |angle| is at least min_rotation; else the states as they are.
-WorkingImage orientedStates(const cv::Mat1b& map_states, double angle, const DefaultOptions& P) {
-  WorkingImage work;
-  work.rotated = std::abs(angle) * 180.0 / CV_PI >= P.min_rotation;
-  work.states = map_states;
-  if (!work.rotated) return work;
-  const double c = std::cos(-angle), s = std::sin(-angle);
-  const double w = map_states.cols, h = map_states.rows;
-  const int W = static_cast<int>(std::ceil(std::abs(c) * w + std::abs(s) * h)) + 2;
-  const int H = static_cast<int>(std::ceil(std::abs(s) * w + std::abs(c) * h)) + 2;
-  const cv::Point2d centre(w / 2.0, h / 2.0), new_centre(W / 2.0, H / 2.0);
-  work.forward = cv::Matx23d(c, -s, new_centre.x - (c * centre.x - s * centre.y), s, c,
-                             new_centre.y - (s * centre.x + c * centre.y));
-  cv::Mat1b rotated;
-  cv::warpAffine(map_states, rotated, cv::Mat(work.forward), cv::Size(W, H), cv::INTER_NEAREST, cv::BORDER_CONSTANT,
-                 cv::Scalar(kUnknownPx));
-  work.states = rotated;
-  return work;
-}
-
-// Step 2, extent: every door of the request in the working frame, placed on its wall (placeDoor) with its lateral
-// extent (lateralExtent); a door that cannot be placed keeps ok = false and its problem.
-std::vector<DoorFrame> framedDoors(const PredictionRequest& request, const DefaultOptions& P, const WorkingImage& work,
-                                   const Frame& f) {
+// Step 1, extent: every door of the request, placed on its wall (placeDoor) with its lateral extent
+// (lateralExtent); a door that cannot be placed keeps ok = false and its problem.
+std::vector<DoorFrame> framedDoors(const PredictionRequest& request, const DefaultOptions& P, const Frame& f) {
   const common::OccupancyGrid& map = request.map;
   const double resolution = map.resolution;
   std::vector<DoorFrame> doors(request.doors.doors.size());
@@ -488,8 +440,7 @@ std::vector<DoorFrame> framedDoors(const PredictionRequest& request, const Defau
     cv::Point unused;
     if (!nearestUnknownCell(map, door.position, P.start_search_radius, &unused, &d.problem)) continue;
     const common::Point2 image = map.toImage(door.position);
-    const cv::Point2d q = applyAffine(work.forward, cv::Point2d(image.x(), image.y()));
-    d.p = cv::Point(static_cast<int>(std::floor(q.x)), static_cast<int>(std::floor(q.y)));
+    d.p = cv::Point(static_cast<int>(std::floor(image.x())), static_cast<int>(std::floor(image.y())));
     d.a = door.orientation == common::DoorOrientation::kAlongX ? cv::Point(1, 0) : cv::Point(0, 1);
     d.n = cv::Point(d.a.y, d.a.x);
     d.half_width = std::max(1, static_cast<int>(0.5 * door.width / resolution));
@@ -675,12 +626,11 @@ std::vector<cv::Mat1b> roomMasks(const Frame& f, const std::vector<DoorFrame>& d
   return masks;
 }
 
-// The rooms in the map's frame, one per door of the request: the masks turned back (when the work image was
-// rotated) without the map's known cells (`map_known`, 255), with the rectangle's terms; unplaced doors get an
-// empty room with their problem.
-std::vector<RoomPrediction> mapFrameRooms(const PredictionRequest& request, const WorkingImage& work, double angle,
-                                          const std::vector<DoorFrame>& doors, const std::vector<cv::Rect>& rects,
-                                          const std::vector<cv::Mat1b>& masks, const cv::Mat1b& map_known) {
+// The rooms, one per door of the request: the masks without the map's known cells (`map_known`, 255), with the
+// rectangle's terms; unplaced doors get an empty room with their problem.
+std::vector<RoomPrediction> mapFrameRooms(const PredictionRequest& request, const std::vector<DoorFrame>& doors,
+                                          const std::vector<cv::Rect>& rects, const std::vector<cv::Mat1b>& masks,
+                                          const cv::Mat1b& map_known) {
   const common::OccupancyGrid& map = request.map;
   const double resolution = map.resolution;
   std::vector<RoomPrediction> rooms;
@@ -688,23 +638,16 @@ std::vector<RoomPrediction> mapFrameRooms(const PredictionRequest& request, cons
     RoomPrediction room;
     room.door_id = request.doors.doors[i].id;
     room.problem = doors[i].problem;
-    // Where the room's cells lie: its rectangle, or anywhere on a turned map.
-    cv::Rect cells_within(0, 0, map.width(), map.height());
+    cv::Rect cells_within(0, 0, map.width(), map.height());  // where the room's cells lie: its rectangle
     if (doors[i].ok && !masks[i].empty()) {
-      if (work.rotated) {
-        cv::warpAffine(masks[i], room.mask, cv::Mat(work.forward), map.cells.size(),
-                       cv::INTER_NEAREST | cv::WARP_INVERSE_MAP, cv::BORDER_CONSTANT, cv::Scalar(0));
-      } else {
-        room.mask = masks[i];
-        cells_within &= rects[i];
-      }
+      room.mask = masks[i];
+      cells_within &= rects[i];
       room.mask(cells_within).setTo(0, map_known(cells_within));
       room.terms["width"] = (doors[i].right - doors[i].left + 1) * resolution;
       room.terms["depth"] = doors[i].depth * resolution;
       room.terms["depth_bounded"] = doors[i].bounded ? 1.0 : 0.0;
       room.terms["depth_source"] = doors[i].depth_source;
       room.terms["lateral_open"] = doors[i].lateral_open ? 1.0 : 0.0;
-      room.terms["rotation"] = angle * 180.0 / CV_PI;
     } else {
       room.mask = cv::Mat1b::zeros(map.cells.size());
     }
@@ -714,32 +657,68 @@ std::vector<RoomPrediction> mapFrameRooms(const PredictionRequest& request, cons
   return rooms;
 }
 
-// The wall-fitted rectangle of every door (steps 1 to 3 of the header), in the map's frame; `angle` is the map's
-// dominantWallAngle, `map_states` its statesOf and `map_known` its known cells (255).
-std::vector<RoomPrediction> rectangleRooms(const PredictionRequest& request, const DefaultOptions& P, double angle,
+// The wall-fitted rectangle of every door (steps 1 to 3 of the header); `map_states` is the map's statesOf and
+// `map_known` its known cells (255).
+std::vector<RoomPrediction> rectangleRooms(const PredictionRequest& request, const DefaultOptions& P,
                                            const cv::Mat1b& map_states, const cv::Mat1b& map_known) {
   const double resolution = request.map.resolution;
-  const WorkingImage work = orientedStates(map_states, angle, P);
-  const Frame f(work.states, cv::boundingRect(work.states != kUnknownPx));
-  std::vector<DoorFrame> doors = framedDoors(request, P, work, f);
+  const Frame f(map_states, cv::boundingRect(map_states != kUnknownPx));
+  std::vector<DoorFrame> doors = framedDoors(request, P, f);
   const std::vector<std::vector<int>> siblings = splitSharedExtents(resolution, &doors);
   measureDepths(f, resolution, P, siblings, &doors);
   std::vector<cv::Rect> rects = doorRectangles(f, doors);
   separateOverlaps(f, doors, std::max(1, static_cast<int>(std::lround(P.min_depth / resolution))), &rects);
-  const std::vector<cv::Mat1b> masks = roomMasks(f, doors, rects, work.states);
-  return mapFrameRooms(request, work, angle, doors, rects, masks, map_known);
+  const std::vector<cv::Mat1b> masks = roomMasks(f, doors, rects, map_states);
+  return mapFrameRooms(request, doors, rects, masks, map_known);
 }
 
-}  // namespace
+// A map turned straight: its cells turned by -angle about their centre onto a grid large enough for all of them,
+// and the doors moved with them. `forward` takes a pixel of the map to the turned grid's.
+struct StraightRequest {
+  PredictionRequest request;
+  cv::Matx23d forward;
+};
 
-PredictionResult DefaultPredictor::predict(const PredictionRequest& request) const {
-  const auto start_time = std::chrono::steady_clock::now();
-  checkUsableMap(request.map);
-  const auto values = resolveParameters(*this, request.parameters);
-  DefaultOptions P;
-  common::applyOptionValues(defaultOptionTable(), values, &P, "parameter ");
-  common::validateOptions(defaultOptionTable(), P, "parameter ");
+StraightRequest turnedStraight(const PredictionRequest& request, double angle) {
+  const cv::Size size = request.map.cells.size();
+  const double c = std::cos(-angle), s = std::sin(-angle);
+  const int W = static_cast<int>(std::ceil(std::abs(c) * size.width + std::abs(s) * size.height)) + 2;
+  const int H = static_cast<int>(std::ceil(std::abs(s) * size.width + std::abs(c) * size.height)) + 2;
+  const cv::Point2d centre(size.width / 2.0, size.height / 2.0), new_centre(W / 2.0, H / 2.0);
+  StraightRequest straight;
+  straight.forward = cv::Matx23d(c, -s, new_centre.x - (c * centre.x - s * centre.y), s, c,
+                                 new_centre.y - (s * centre.x + c * centre.y));
+  // Each state turned with linear interpolation, so that a turned wall stays a closed line (nearest-pixel
+  // sampling breaks a thin wall into steps with gaps): a cell is a wall when walls cover a quarter of it, else
+  // free when free space covers half of it, else unknown.
+  const cv::Mat1b states = statesOf(request.map);
+  const auto turned = [&](uint8_t state) {
+    cv::Mat1b moved;
+    cv::warpAffine(states == state, moved, cv::Mat(straight.forward), cv::Size(W, H), cv::INTER_LINEAR,
+                   cv::BORDER_CONSTANT, cv::Scalar(0));
+    return moved;
+  };
+  common::OccupancyGrid& map = straight.request.map;
+  map.resolution = request.map.resolution;
+  map.origin = common::Point2::Zero();
+  map.cells = cv::Mat_<int8_t>(cv::Size(W, H), common::OccupancyGrid::kUnknown);
+  map.cells.setTo(common::OccupancyGrid::kFree, turned(kFreePx) >= 128);
+  map.cells.setTo(common::OccupancyGrid::kOccupied, turned(kOccupiedPx) >= 64);
+  straight.request.doors = request.doors;
+  for (common::MapDoor& door : straight.request.doors.doors) {
+    const common::Point2 image = request.map.toImage(door.position);
+    const cv::Point2d q = applyAffine(straight.forward, cv::Point2d(image.x(), image.y()));
+    door.position = common::Point2(q.x * map.resolution, (H - q.y) * map.resolution);
+  }  // |angle| < 45 degrees: each door's wall stays closest to the axis its orientation names
+  straight.request.parameters = request.parameters;
+  straight.request.debug_dir = request.debug_dir;
+  return straight;
+}
 
+// The rooms of a map whose walls run along x and y: rectangle or grown room per door, then the outline clip and
+// the wall margin (the header's steps).
+PredictionResult roomsOnStraightMap(const PredictionRequest& request, const std::map<std::string, double>& values,
+                                    const DefaultOptions& P) {
   // The grown rooms: the thesis's growth with its own constants on the layout this request configures. It does
   // not depend on the rectangles, so it runs on a second thread meanwhile.
   PredictionRequest grown_request;
@@ -750,20 +729,14 @@ PredictionResult DefaultPredictor::predict(const PredictionRequest& request) con
   std::future<PredictionResult> growth =
       std::async(std::launch::async, [&grown_request] { return ThesisPredictor().predict(grown_request); });
 
-  const double angle = dominantWallAngle(request.map);
   const cv::Mat1b states = statesOf(request.map);
   const cv::Mat1b known = request.map.cells != common::OccupancyGrid::kUnknown;
-  std::vector<RoomPrediction> rectangles = rectangleRooms(request, P, angle, states, known);
+  std::vector<RoomPrediction> rectangles = rectangleRooms(request, P, states, known);
   const double resolution = request.map.resolution;
   // Cells within the wall margin of an occupied cell: the unseen rest of the walls the robot saw from one side.
   const double wall_margin = P.wall_margin >= 0.0 ? P.wall_margin : unseenWallMetres(states, resolution);
 
-  // The layout's cells are axis-aligned: on a turned map only the rectangles (built on the map turned straight),
-  // and the growth's result (or error) is dropped.
-  const bool turned = std::abs(angle) * 180.0 / CV_PI >= P.min_rotation;
-  std::vector<RoomPrediction> grown(rectangles.size());
-  if (turned) growth.wait();
-  else grown = growth.get().rooms;
+  std::vector<RoomPrediction> grown = growth.get().rooms;
 
   // Per door: the grown room, unless it is much smaller than the rectangle (it stopped short of the walls the
   // rectangle found) or missing; a rectangle gives up the pixels of the grown rooms kept for other doors.
@@ -772,7 +745,7 @@ PredictionResult DefaultPredictor::predict(const PredictionRequest& request) con
   std::vector<cv::Rect> boxes(count);  // bounding box of each chosen room: every later step only removes cells
   cv::Mat1b kept_grown = cv::Mat1b::zeros(request.map.cells.size());
   for (size_t i = 0; i < count; ++i) {
-    use_rectangle[i] = turned || (rectangles[i].placed && grown[i].area < P.grown_area_ratio * rectangles[i].area);
+    use_rectangle[i] = rectangles[i].placed && grown[i].area < P.grown_area_ratio * rectangles[i].area;
     const RoomPrediction& room = use_rectangle[i] ? rectangles[i] : grown[i];
     if (room.placed) boxes[i] = cv::boundingRect(room.mask);
     if (!use_rectangle[i] && grown[i].placed) kept_grown(boxes[i]) |= grown[i].mask(boxes[i]);
@@ -793,20 +766,39 @@ PredictionResult DefaultPredictor::predict(const PredictionRequest& request) con
       wall_band(box).setTo(255, distance * resolution <= wall_margin);
     }
   }
+  std::vector<RoomPrediction> chosen(count);
+  for (size_t i = 0; i < count; ++i) {
+    chosen[i] = std::move(use_rectangle[i] ? rectangles[i] : grown[i]);
+    if (use_rectangle[i]) {
+      chosen[i].mask(boxes[i]).setTo(0, kept_grown(boxes[i]));
+      finishPrediction(request.map, &chosen[i], boxes[i]);
+    }
+  }
+  const bool clip = P.outline_reach > 0.0;
+  const int outline_reach = static_cast<int>(std::lround(P.outline_reach / resolution));
+  const int min_depth = static_cast<int>(std::lround(P.min_depth / resolution));
+  // The other doors' rooms are part of the building too: a known wall with another closed door's room beyond it
+  // does not bound a room like an outer wall. So each room is clipped to the known map together with the other
+  // rooms as the known map alone clips them (claims: how many rooms claim each pixel).
+  cv::Mat1w claims = cv::Mat1w::zeros(request.map.cells.size());
+  std::vector<cv::Mat1b> first_clip(count);
+  for (size_t i = 0; clip && i < count; ++i) {
+    if (!chosen[i].placed) continue;
+    first_clip[i] = chosen[i].mask.clone();
+    clipToKnownOutline(known, doorPixel(request.map, request.doors.doors[i]), outline_reach, min_depth,
+                       &first_clip[i]);
+    cv::add(claims, cv::Scalar(1), claims, first_clip[i]);
+  }
   PredictionResult result;
   for (size_t i = 0; i < count; ++i) {
-    RoomPrediction room = std::move(use_rectangle[i] ? rectangles[i] : grown[i]);
+    RoomPrediction room = std::move(chosen[i]);
     const cv::Rect& box = boxes[i];
     const auto cells = [&] { return cv::countNonZero(room.mask(box)); };
-    if (use_rectangle[i]) {
-      room.mask(box).setTo(0, kept_grown(box));
-      finishPrediction(request.map, &room, box);
-    }
-    if (!turned && P.outline_reach > 0.0 && room.placed) {
+    if (clip && room.placed) {
       const int before = cells();
-      clipToKnownOutline(known, doorPixel(request.map, request.doors.doors[i]),
-                         static_cast<int>(std::lround(P.outline_reach / resolution)),
-                         static_cast<int>(std::lround(P.min_depth / resolution)), &room.mask);
+      const cv::Mat1b building = known | (claims >= 2) | ((claims == 1) & ~first_clip[i]);
+      clipToKnownOutline(building, doorPixel(request.map, request.doors.doors[i]), outline_reach, min_depth,
+                         &room.mask);
       room.terms["outline_clipped"] = (before - cells()) * resolution * resolution;
       finishPrediction(request.map, &room, box);
     }
@@ -820,6 +812,42 @@ PredictionResult DefaultPredictor::predict(const PredictionRequest& request) con
     room.terms["rectangle"] = use_rectangle[i] ? 1.0 : 0.0;
     result.rooms.push_back(std::move(room));
   }
+  return result;
+}
+
+}  // namespace
+
+PredictionResult DefaultPredictor::predict(const PredictionRequest& request) const {
+  const auto start_time = std::chrono::steady_clock::now();
+  checkUsableMap(request.map);
+  const auto values = resolveParameters(*this, request.parameters);
+  DefaultOptions P;
+  common::applyOptionValues(defaultOptionTable(), values, &P, "parameter ");
+  common::validateOptions(defaultOptionTable(), P, "parameter ");
+
+  // A turned map (every SLAM map is a little) is predicted turned straight, where the layout's cells and the
+  // rectangles are axis-aligned, and its rooms are turned back.
+  const double degrees = dominantWallAngle(request.map) * 180.0 / CV_PI;
+  PredictionResult result;
+  if (std::abs(degrees) < P.min_rotation) {
+    result = roomsOnStraightMap(request, values, P);
+  } else {
+    const StraightRequest straight = turnedStraight(request, degrees * CV_PI / 180.0);
+    result = roomsOnStraightMap(straight.request, values, P);
+    const cv::Mat1b known = request.map.cells != common::OccupancyGrid::kUnknown;
+    for (RoomPrediction& room : result.rooms) {
+      if (!room.placed) {
+        room.mask = cv::Mat1b::zeros(request.map.cells.size());
+        continue;
+      }
+      cv::Mat1b back;
+      cv::warpAffine(room.mask, back, cv::Mat(straight.forward), request.map.cells.size(),
+                     cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_CONSTANT, cv::Scalar(0));
+      room.mask = (back >= 128) & ~known;
+      finishPrediction(request.map, &room);
+    }
+  }
+  for (RoomPrediction& room : result.rooms) room.terms["rotation"] = degrees;
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
   return result;
 }

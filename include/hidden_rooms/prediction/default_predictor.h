@@ -4,16 +4,15 @@
 // around the door, or the room grown on the layout's cell grid by the thesis's method (thesis_predictor.h, with
 // its default parameters) when that room is at least default_grown_area_ratio times the rectangle (the
 // rectangle stopped short, e.g. of an L-shaped room) or the rectangle is missing. A rectangle gives up
-// the pixels of the grown rooms kept for the other doors. On a map whose dominant wall angle is at least
-// default_min_rotation (the layout's cells are axis-aligned) every door gets its rectangle. The growth runs on a
-// second thread while the rectangles are fitted (predict() is still safe to call from several threads).
+// the pixels of the grown rooms kept for the other doors. The growth runs on a second thread while the
+// rectangles are fitted (predict() is still safe to call from several threads).
 //
-// The rectangles:
-// 1. Orientation: the dominant wall direction (modulo 90 degrees) from the gradient directions of the occupied
-//    pixels; the map and its doors are rotated so that the walls run along x and y, and the rooms are rotated
-//    back at the end.
-// 2. Per door, in the door's frame (u along the door's wall, v into the unknown side):
-//    - the wall: the occupied pixels across the door; the room starts at the first unknown row behind it;
+// Turned maps: when the dominant wall direction (dominantWallAngle, modulo 90 degrees) is at least
+// default_min_rotation, the whole prediction runs on the map turned straight (walls along x and y, as the
+// layout's cells and the rectangles need) with its doors, and the rooms are turned back onto the map.
+//
+// The rectangles, per door, in the door's frame (u along the door's wall, v into the unknown side):
+// 1. - the wall: the occupied pixels across the door; the room starts at the first unknown row behind it;
 //    - lateral extent: along the wall from the door in both directions while the wall continues (gaps up to
 //      default_wall_gap, e.g. open doorways) and the space just behind it is still unknown (a known pixel
 //      there is a perpendicular wall of an explored room);
@@ -23,27 +22,30 @@
 //      median when enough columns end on a known pixel inside the known map's bounding box, else a prior: the
 //      depth of the explored rooms on the same side of the same wall, else of the other hidden rooms on that
 //      side, else the room's width (a square, as the thesis does).
-//    - overlapping rectangles of doors on perpendicular walls: the overlap goes to the door nearer to it (along
-//      that door's normal) and the other room ends where the overlap begins, if it keeps default_min_depth;
-//      other overlaps are cut halfway between the doors;
+// 2. Overlapping rectangles of doors on perpendicular walls: the overlap goes to the door nearer to it (along
+//    that door's normal) and the other room ends where the overlap begins, if it keeps default_min_depth;
+//    other overlaps are cut halfway between the doors.
 // 3. The rectangle's unknown pixels connected to the door; pixels claimed by several rooms go to the nearest
 //    door.
 // Lateral extent and wall stubs: a stub ends the extent unless the wall goes on past it at another row (the side
 // wall of a door niche or of a step in the wall: no free space beyond it and wall pixels within its length).
 //
-// Every room, grown or rectangle (not on turned maps), is then clipped to the known map's outline beside it
-// (clipToKnownOutline, default_outline_reach): a room does not stick out of the building past the outer walls
-// its neighbours show; a side where nothing is known beyond the door is left open. Last, every room leaves out
-// the unknown cells within default_wall_margin of a wall cell: a wall the robot saw from one side shows only its
-// near face in a SLAM map, and the rest of its thickness is no room's. A negative margin (the default) is
-// estimated from the map (unseenWallThickness): 0 on maps that draw whole walls.
+// Every room, grown or rectangle, is then clipped to the building's outline beside it (clipToKnownOutline,
+// default_outline_reach): a room does not stick out of the building past the outer walls its neighbours show; a
+// side where nothing is known beyond the door is left open. The building is the known map and the other doors'
+// rooms (as the known map alone clips them): a known wall with another hidden room behind it is no outer wall.
+// Last, every room leaves out the unknown cells within default_wall_margin of a wall cell: a wall the robot saw
+// from one side shows only its near face in a SLAM map, and the rest of its thickness is no room's. A negative
+// margin (the default) is estimated from the map (unseenWallThickness): 0 on maps that draw whole walls.
 //
 // Parameters: start_search_radius and the default_* keys (config/prediction.yaml), and the layout's
-// (config/layout.yaml) for the grown rooms; --debug-dir receives the layout's images.
+// (config/layout.yaml) for the grown rooms; --debug-dir receives the layout's images (of the map turned
+// straight, on a turned map).
 // terms: "rectangle" (1 when the rectangle was chosen, 0 the grown room); a grown room has the thesis's terms, a
-// rectangle "width", "depth" (metres), "depth_bounded" (1 when the depth came from the map, 0 from a prior) and
-// "rotation" (degrees the map was turned); every room "outline_clipped" (m^2 removed by the outline clip) and,
-// with a margin, "wall_margin" (metres) and "wall_margin_cut" (m^2 removed by it).
+// rectangle "width", "depth" (metres), "depth_bounded" (1 when the depth came from the map, 0 from a prior);
+// every room "rotation" (the dominant wall angle, degrees; the map was turned when it is at least
+// default_min_rotation), "outline_clipped" (m^2 removed by the outline clip) and, with a margin, "wall_margin"
+// (metres) and "wall_margin_cut" (m^2 removed by it).
 
 #include <map>
 #include <string>
@@ -61,7 +63,7 @@ struct DefaultOptions {
   double bounded_fraction = 0.5;     // share of columns ending on a known pixel for a measured depth
   double neighbour_reach = 15.0;     // m: how far along the wall explored neighbours are looked for
   double min_depth = 2.0;            // m: smallest depth taken from the square prior
-  double min_rotation = 1.0;         // degrees: smaller dominant angles are not corrected
+  double min_rotation = 1.0;         // degrees: maps turned less are not predicted turned straight
   double grown_area_ratio = 1.25;    // grown rooms less than this many times the rectangle give way
   double stub_length = 0.3;          // m: wall stubs this long into the explored side end a room's extent
   double outline_reach = 15.0;       // m: band beside a room within which the known map's extent bounds it
@@ -80,7 +82,8 @@ class DefaultPredictor : public RoomPredictor {
 };
 
 // Dominant wall direction of a map, radians in [-pi/4, pi/4): the walls run along this angle and the one
-// perpendicular to it (image frame: x = column, y = row). 0 when the map has no occupied cells.
+// perpendicular to it (image frame: x = column, y = row). The angle whose projection profiles of the occupied
+// cells (along it and across it) are sharpest, searched to 0.02 degrees. 0 when the map has no occupied cells.
 double dominantWallAngle(const common::OccupancyGrid& map);
 
 // How much of the thickness of walls seen from one side a map does not show, metres: the most common length
