@@ -315,31 +315,38 @@ TEST(DefaultPredictor, ClipsRoomsToTheKnownOutlineBesideThem) {
   EXPECT_EQ(cv::boundingRect(alone), cv::Rect(10, 0, 40, 80));
 }
 
+// An unknown floor of `size` cells (0.05 m) to draw a case on, and a door (along x) at an image point.
+Synthetic blankFloor(const cv::Size& size) {
+  Synthetic s;
+  s.request.map.resolution = 0.05;
+  s.request.map.cells = cv::Mat_<int8_t>(size, common::OccupancyGrid::kUnknown);
+  s.truth = cv::Mat1w::zeros(size);
+  return s;
+}
+
+void addDoor(Synthetic* s, int id, double col, double row) {
+  common::MapDoor door;
+  door.id = id;
+  door.orientation = common::DoorOrientation::kAlongX;
+  door.position = common::Point2(col * s->request.map.resolution,
+                                 (s->request.map.height() - row) * s->request.map.resolution);
+  s->request.doors.doors.push_back(door);
+}
+
 // A corridor that widens beside a hidden room, with another hidden room behind the widening (failure pattern 3
 // and 1 of the unseen maps: all rooms along a corridor hidden). The widening's far wall is not the building's
 // outline: another closed door's room lies behind it. So it does not cut the first room to a strip.
 TEST(DefaultPredictor, AWallWithAnotherHiddenRoomBehindItDoesNotClipLikeAnOuterWall) {
-  const cv::Size size(400, 260);
-  Synthetic s;
+  Synthetic s = blankFloor(cv::Size(400, 260));
   common::OccupancyGrid& map = s.request.map;
-  map.resolution = 0.05;
-  map.cells = cv::Mat_<int8_t>(size, common::OccupancyGrid::kUnknown);
   map.cells(cv::Rect(10, 175, 380, 50)).setTo(common::OccupancyGrid::kOccupied);  // around the corridor
   map.cells(cv::Rect(186, 135, 118, 45)).setTo(common::OccupancyGrid::kOccupied);  // around the widening
   map.cells(cv::Rect(13, 178, 374, 44)).setTo(common::OccupancyGrid::kFree);       // corridor, rows 178..221
   map.cells(cv::Rect(189, 138, 112, 45)).setTo(common::OccupancyGrid::kFree);      // widening, 2 m deep
-  s.truth = cv::Mat1w::zeros(size);
   s.truth(cv::Rect(13, 20, 170, 155)).setTo(1);   // room A above the corridor, 8.5 x 7.75 m
   s.truth(cv::Rect(189, 20, 112, 115)).setTo(2);  // room B above the widening
-  const auto addDoor = [&](int id, double col, double row) {
-    common::MapDoor door;
-    door.id = id;
-    door.orientation = common::DoorOrientation::kAlongX;
-    door.position = common::Point2(col * map.resolution, (size.height - row) * map.resolution);
-    s.request.doors.doors.push_back(door);
-  };
-  addDoor(1, 98, 176.5);
-  addDoor(2, 245, 136.5);
+  addDoor(&s, 1, 98, 176.5);
+  addDoor(&s, 2, 245, 136.5);
   const evaluation::RoomScores scores = scoreOf(s, makeRoomPredictor("default")->predict(s.request));
   std::printf("IoU room A %.3f, room B %.3f\n", scores.iou[0], scores.iou[1]);
   // Clipped to the widening's far wall (2 m), as before this rule, room A scored 0.257.
@@ -375,23 +382,15 @@ Synthetic turned(const Synthetic& s, double degrees) {
 // (failure pattern 5 of the unseen maps): the explored room shows where the building ends, on a map turned by a
 // few degrees too.
 TEST(DefaultPredictor, ClipsToTheOutlineOnATurnedMap) {
-  const cv::Size size(300, 240);
-  Synthetic s;
+  Synthetic s = blankFloor(cv::Size(300, 240));
   common::OccupancyGrid& map = s.request.map;
-  map.resolution = 0.05;
-  map.cells = cv::Mat_<int8_t>(size, common::OccupancyGrid::kUnknown);
   map.cells(cv::Rect(17, 177, 266, 46)).setTo(common::OccupancyGrid::kOccupied);   // around the corridor
   map.cells(cv::Rect(147, 115, 126, 65)).setTo(common::OccupancyGrid::kOccupied);  // around the explored room
   map.cells(cv::Rect(20, 180, 260, 40)).setTo(common::OccupancyGrid::kFree);       // corridor
   map.cells(cv::Rect(150, 118, 120, 59)).setTo(common::OccupancyGrid::kFree);      // explored room, 3 m deep
   map.cells(cv::Rect(160, 177, 20, 3)).setTo(common::OccupancyGrid::kFree);        // its open door
-  s.truth = cv::Mat1w::zeros(size);
   s.truth(cv::Rect(20, 118, 124, 59)).setTo(1);  // the hidden room, 6.2 m wide and 3 m deep
-  common::MapDoor door;
-  door.id = 1;
-  door.orientation = common::DoorOrientation::kAlongX;
-  door.position = common::Point2(85 * map.resolution, (size.height - 178.5) * map.resolution);
-  s.request.doors.doors.push_back(door);
+  addDoor(&s, 1, 85, 178.5);
   const auto predictor = makeRoomPredictor("default");
   const double straight = scoreOf(s, predictor->predict(s.request)).iou[0];
   const Synthetic tilted = turned(s, 4.0);

