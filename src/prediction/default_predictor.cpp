@@ -766,39 +766,20 @@ PredictionResult roomsOnStraightMap(const PredictionRequest& request, const std:
       wall_band(box).setTo(255, distance * resolution <= wall_margin);
     }
   }
-  std::vector<RoomPrediction> chosen(count);
-  for (size_t i = 0; i < count; ++i) {
-    chosen[i] = std::move(use_rectangle[i] ? rectangles[i] : grown[i]);
-    if (use_rectangle[i]) {
-      chosen[i].mask(boxes[i]).setTo(0, kept_grown(boxes[i]));
-      finishPrediction(request.map, &chosen[i], boxes[i]);
-    }
-  }
-  const bool clip = P.outline_reach > 0.0;
-  const int outline_reach = static_cast<int>(std::lround(P.outline_reach / resolution));
-  const int min_depth = static_cast<int>(std::lround(P.min_depth / resolution));
-  // The other doors' rooms are part of the building too: a known wall with another closed door's room beyond it
-  // does not bound a room like an outer wall. So each room is clipped to the known map together with the other
-  // rooms as the known map alone clips them (claims: how many rooms claim each pixel).
-  cv::Mat1w claims = cv::Mat1w::zeros(request.map.cells.size());
-  std::vector<cv::Mat1b> first_clip(count);
-  for (size_t i = 0; clip && i < count; ++i) {
-    if (!chosen[i].placed) continue;
-    first_clip[i] = chosen[i].mask.clone();
-    clipToKnownOutline(known, doorPixel(request.map, request.doors.doors[i]), outline_reach, min_depth,
-                       &first_clip[i]);
-    cv::add(claims, cv::Scalar(1), claims, first_clip[i]);
-  }
   PredictionResult result;
   for (size_t i = 0; i < count; ++i) {
-    RoomPrediction room = std::move(chosen[i]);
+    RoomPrediction room = std::move(use_rectangle[i] ? rectangles[i] : grown[i]);
     const cv::Rect& box = boxes[i];
     const auto cells = [&] { return cv::countNonZero(room.mask(box)); };
-    if (clip && room.placed) {
+    if (use_rectangle[i]) {
+      room.mask(box).setTo(0, kept_grown(box));
+      finishPrediction(request.map, &room, box);
+    }
+    if (P.outline_reach > 0.0 && room.placed) {
       const int before = cells();
-      const cv::Mat1b building = known | (claims >= 2) | ((claims == 1) & ~first_clip[i]);
-      clipToKnownOutline(building, doorPixel(request.map, request.doors.doors[i]), outline_reach, min_depth,
-                         &room.mask);
+      clipToKnownOutline(known, doorPixel(request.map, request.doors.doors[i]),
+                         static_cast<int>(std::lround(P.outline_reach / resolution)),
+                         static_cast<int>(std::lround(P.min_depth / resolution)), &room.mask);
       room.terms["outline_clipped"] = (before - cells()) * resolution * resolution;
       finishPrediction(request.map, &room, box);
     }

@@ -30,11 +30,9 @@
 // Lateral extent and wall stubs: a stub ends the extent unless the wall goes on past it at another row (the side
 // wall of a door niche or of a step in the wall: no free space beyond it and wall pixels within its length).
 //
-// Every room, grown or rectangle, is then clipped to the building's outline beside it (clipToKnownOutline,
+// Every room, grown or rectangle, is then clipped to the known map's outline beside it (clipToKnownOutline,
 // default_outline_reach): a room does not stick out of the building past the outer walls its neighbours show; a
-// side where nothing is known beyond the door is left open. The building is the known map and the other doors'
-// rooms (as the known map alone clips them): a known wall with another hidden room behind it is no outer wall.
-// Last, every room leaves out the unknown cells within default_wall_margin of a wall cell: a wall the robot saw
+// side where nothing is known beyond the door is left open. Last, every room leaves out the unknown cells within default_wall_margin of a wall cell: a wall the robot saw
 // from one side shows only its near face in a SLAM map, and the rest of its thickness is no room's. A negative
 // margin (the default) is estimated from the map (unseenWallThickness): 0 on maps that draw whole walls.
 //
