@@ -71,8 +71,7 @@ BatchCase makeBatchCase(const world::Environment& environment, const std::vector
   std::vector<int> rooms;
   for (const common::MapDoor& door : result.input.closed_doors.doors)
     rooms.push_back(world::roomBehindDoor(environment, environment.findDoor(std::to_string(door.id))));
-  const world::RenderedEnvironment all_open = world::renderEnvironment(environment, {}, options);
-  result.room_coverage = roomCoverage(result.input.true_rooms, rendered.map.resolution, rooms, all_open);
+  result.room_coverage = roomCoverage(result.input.true_rooms, rendered.map.resolution, rooms, rendered);
   result.seconds = secondsSince(start);
   return result;
 }

@@ -63,10 +63,36 @@ def explored_dir(store, name):
     return os.path.join(store, "explored", name)
 
 
+def has_run(store, name):
+    """True when the store holds every file of a run of `name`."""
+    return all(os.path.isfile(os.path.join(explored_dir(store, name), f)) for f in STORE_FILES)
+
+
+def run_tool(command, what):
+    """Runs one of the package's tools; returns its stdout, raises CorpusError with its message when it fails."""
+    result = subprocess.run(command, capture_output=True, text=True, stdin=subprocess.DEVNULL)
+    if result.returncode != 0:
+        raise CorpusError("%s: %s" % (what, tool_error(result, what)))
+    return result.stdout
+
+
+def explore_and_score(binaries, path, out, seed, max_time, config, closed=""):
+    """explore_offline of one environment into `out`, scored by translate_doors into `out`/score."""
+    run_tool([binaries["explore_offline"], path, "--config", config, "--out", out, "--closed", closed, "--seed",
+              str(seed), "--max-time", str(max_time), "--pose-period", "0.5", "--quiet"], "explore_offline")
+    run_tool([binaries["translate_doors"], "--environment", path, "--closed", closed, "--truth",
+              os.path.join(out, "truth.log"), "--estimate", os.path.join(out, "estimate.log"), "--map",
+              os.path.join(out, "map.yaml"), "--out", os.path.join(out, "score")], "translate_doors")
+
+
+def default_config(args):
+    return os.path.abspath(args.config or os.path.join(REPO_DIR, "config", "rbpf.ini"))
+
+
 def is_explored(store, name, settings):
     """True when the store holds a complete run of `name` made with these settings."""
     folder = explored_dir(store, name)
-    if not all(os.path.isfile(os.path.join(folder, f)) for f in STORE_FILES):
+    if not has_run(store, name):
         return False
     with open(os.path.join(folder, "run.yaml")) as stream:
         run = yaml.safe_load(stream) or {}
@@ -78,21 +104,10 @@ def explore_one(path, store, settings, binaries):
     name = environment_name(path)
     work = tempfile.mkdtemp(prefix="corpus_%s_" % name)
     try:
-        command = [binaries["explore_offline"], path, "--config", settings["config"], "--out", work, "--seed",
-                   str(settings["seed"]), "--max-time", str(settings["max_time"]), "--pose-period", "0.5",
-                   "--quiet"]
-        with open(os.path.join(work, "explore.log"), "w") as log:
-            result = subprocess.run(command, stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL)
-        if result.returncode != 0:
-            with open(os.path.join(work, "explore.log"), errors="replace") as log:
-                lines = [line for line in log.read().splitlines() if "explore_offline" in line]
-            return name, "explore_offline failed (exit %d): %s" % (result.returncode, lines[-1] if lines else "")
-        score = subprocess.run(
-            [binaries["translate_doors"], "--environment", path, "--truth", os.path.join(work, "truth.log"),
-             "--estimate", os.path.join(work, "estimate.log"), "--map", os.path.join(work, "map.yaml"), "--out",
-             os.path.join(work, "score")], capture_output=True, text=True, stdin=subprocess.DEVNULL)
-        if score.returncode != 0:
-            return name, "translate_doors failed: %s" % tool_error(score, "translate_doors")
+        try:
+            explore_and_score(binaries, path, work, settings["seed"], settings["max_time"], settings["config"])
+        except CorpusError as error:
+            return name, str(error)
         with open(os.path.join(work, "run.yaml"), "a") as run:
             run.write("max_time: %s\n" % settings["max_time"])
         shutil.copy(os.path.join(work, "score", "exploration.yaml"), os.path.join(work, "exploration.yaml"))
@@ -117,8 +132,7 @@ def explore(args):
     if len(set(names)) != len(names):
         raise CorpusError("two environments have the same file name; the store keys them by name")
     binaries = {name: find_binary(name) for name in ("explore_offline", "translate_doors")}
-    settings = {"seed": args.seed, "max_time": float(args.max_time),
-                "config": os.path.abspath(args.config or os.path.join(REPO_DIR, "config", "rbpf.ini"))}
+    settings = {"seed": args.seed, "max_time": float(args.max_time), "config": default_config(args)}
     os.makedirs(os.path.join(args.store, "explored"), exist_ok=True)
     pending = [path for path in paths if not is_explored(args.store, environment_name(path), settings)]
     print("make_closed_door_corpus: %d environments, %d already explored, %d to explore (%d jobs)" % (
@@ -175,13 +189,10 @@ def find_environment_files(roots):
 
 def batch_cases(binary, name, xml_path, folder, sequence, extra):
     """batch_cases on the explored map of `folder`; returns its JSON lines."""
-    result = subprocess.run(
-        [binary, xml_path, "--sequence", ",".join(map(str, sequence)), "--map", os.path.join(folder, "map.yaml"),
-         "--doors-in-map", os.path.join(folder, "doors.yaml")] + extra,
-        capture_output=True, text=True, stdin=subprocess.DEVNULL)
-    if result.returncode != 0:
-        raise CorpusError("%s: %s" % (name, tool_error(result, "batch_cases")))
-    return [json.loads(line) for line in result.stdout.splitlines()]
+    stdout = run_tool([binary, xml_path, "--sequence", ",".join(map(str, sequence)), "--map",
+                       os.path.join(folder, "map.yaml"), "--doors-in-map", os.path.join(folder, "doors.yaml")] + extra,
+                      "%s: batch_cases" % name)
+    return [json.loads(line) for line in stdout.splitlines()]
 
 
 def mapped_doors(binary, name, xml_path, folder):
@@ -230,8 +241,7 @@ def cases_of_environment(name, xml_path, store, out, settings, binary):
 
 def cases(args):
     split = read_split(args.store)
-    explored = sorted(name for name in os.listdir(os.path.join(args.store, "explored"))
-                      if all(os.path.isfile(os.path.join(explored_dir(args.store, name), f)) for f in STORE_FILES))
+    explored = sorted(name for name in os.listdir(os.path.join(args.store, "explored")) if has_run(args.store, name))
     if args.part:
         explored = [name for name in explored if split.get(name, ("", ""))[1] == args.part]
     if not explored:
@@ -292,39 +302,27 @@ def check(args):
     import numpy as np
     name = environment_name(args.environment)
     folder = explored_dir(args.store, name)
-    if not all(os.path.isfile(os.path.join(folder, f)) for f in STORE_FILES):
+    if not has_run(args.store, name):
         raise CorpusError("%s is not explored in %s" % (name, args.store))
     doors = [int(door) for door in args.closed.split(",") if door.strip()]
     if not doors:
         raise CorpusError("--closed: no door")
     binaries = {tool: find_binary(tool) for tool in ("explore_offline", "translate_doors", "batch_cases",
                                                        "predict_rooms_offline")}
-    config = os.path.abspath(args.config or os.path.join(REPO_DIR, "config", "rbpf.ini"))
     work = args.work or tempfile.mkdtemp(prefix="corpus_check_%s_" % name)
     os.makedirs(work, exist_ok=True)
 
-    def run(command, what):
-        result = subprocess.run(command, capture_output=True, text=True, stdin=subprocess.DEVNULL)
-        if result.returncode != 0:
-            raise CorpusError("%s: %s" % (what, tool_error(result, what)))
-        return result.stdout
-
     closed = ",".join(map(str, doors))
-    derived = json.loads(run([binaries["batch_cases"], args.environment, "--sequence", closed, "--cases",
-                              str(len(doors)), "--map", os.path.join(folder, "map.yaml"), "--doors-in-map",
-                              os.path.join(folder, "doors.yaml"), "--methods", args.method, "--write-cases",
-                              os.path.join(work, "derived")], "batch_cases").splitlines()[-1])
+    derived_dir = os.path.join(work, "derived")
+    derived = batch_cases(binaries["batch_cases"], name, args.environment, folder, doors,
+                          ["--cases", str(len(doors)), "--methods", args.method, "--write-cases", derived_dir])[-1]
+    derived_map = os.path.join(derived_dir, "%d_doors" % len(doors), "map.yaml")
     real = os.path.join(work, "real")
-    run([binaries["explore_offline"], args.environment, "--config", config, "--out", real, "--closed", closed,
-         "--seed", str(args.seed), "--max-time", str(args.max_time), "--pose-period", "0.5", "--quiet"],
-        "explore_offline")
-    run([binaries["translate_doors"], "--environment", args.environment, "--closed", closed, "--truth",
-         os.path.join(real, "truth.log"), "--estimate", os.path.join(real, "estimate.log"), "--map",
-         os.path.join(real, "map.yaml"), "--out", os.path.join(real, "score")], "translate_doors")
-    run([binaries["predict_rooms_offline"], "--map", os.path.join(real, "map.yaml"), "--doors",
-         os.path.join(real, "score", "doors.yaml"), "--method", args.method, "--gt-rooms",
-         os.path.join(real, "score", "true_rooms.png"), "--out", os.path.join(real, "prediction")],
-        "predict_rooms_offline")
+    explore_and_score(binaries, args.environment, real, args.seed, args.max_time, default_config(args), closed)
+    run_tool([binaries["predict_rooms_offline"], "--map", os.path.join(real, "map.yaml"), "--doors",
+              os.path.join(real, "score", "doors.yaml"), "--method", args.method, "--gt-rooms",
+              os.path.join(real, "score", "true_rooms.png"), "--out", os.path.join(real, "prediction")],
+             "predict_rooms_offline")
     with open(os.path.join(real, "prediction", "metrics.yaml")) as stream:
         real_metrics = yaml.safe_load(stream)
     real_ious = [float(room["iou"]) for room in real_metrics["rooms"]]
@@ -334,17 +332,15 @@ def check(args):
         open_fit = yaml.safe_load(stream)["world_from_map"]
     with open(os.path.join(real, "score", "exploration.yaml")) as stream:
         real_fit = yaml.safe_load(stream)["world_from_map"]
-    resolution, shape, origin = 0.05, None, None
+    resolution = 0.05
     corners = []
-    for map_yaml, fit in ((os.path.join(work, "derived", "%d_doors" % len(doors), "map.yaml"), open_fit),
-                          (os.path.join(real, "map.yaml"), real_fit)):
+    for map_yaml, fit in ((derived_map, open_fit), (os.path.join(real, "map.yaml"), real_fit)):
         with open(map_yaml) as stream:
             meta = yaml.safe_load(stream)
         corners.append((meta["origin"][0] + fit[0], meta["origin"][1] + fit[1]))
     origin = (min(c[0] for c in corners) - 20.0, min(c[1] for c in corners) - 20.0)
     shape = (int(240 / resolution), int(240 / resolution))
-    derived_free = free_in_world(os.path.join(work, "derived", "%d_doors" % len(doors), "map.yaml"), open_fit, shape,
-                                 resolution, origin)
+    derived_free = free_in_world(derived_map, open_fit, shape, resolution, origin)
     real_free = free_in_world(os.path.join(real, "map.yaml"), real_fit, shape, resolution, origin)
     union = np.count_nonzero(derived_free | real_free)
     free_iou = np.count_nonzero(derived_free & real_free) / union if union else 0.0

@@ -681,13 +681,14 @@ struct StraightRequest {
 
 StraightRequest turnedStraight(const PredictionRequest& request, double angle) {
   const cv::Size size = request.map.cells.size();
-  const double c = std::cos(-angle), s = std::sin(-angle);
-  const int W = static_cast<int>(std::ceil(std::abs(c) * size.width + std::abs(s) * size.height)) + 2;
-  const int H = static_cast<int>(std::ceil(std::abs(s) * size.width + std::abs(c) * size.height)) + 2;
-  const cv::Point2d centre(size.width / 2.0, size.height / 2.0), new_centre(W / 2.0, H / 2.0);
+  const double c = std::abs(std::cos(angle)), s = std::abs(std::sin(angle));
+  const int W = static_cast<int>(std::ceil(c * size.width + s * size.height)) + 2;
+  const int H = static_cast<int>(std::ceil(s * size.width + c * size.height)) + 2;
   StraightRequest straight;
-  straight.forward = cv::Matx23d(c, -s, new_centre.x - (c * centre.x - s * centre.y), s, c,
-                                 new_centre.y - (s * centre.x + c * centre.y));
+  // The turn about the map's centre, then that centre moved to the turned grid's.
+  straight.forward = cv::getRotationMatrix2D(cv::Point2f(size.width / 2.0f, size.height / 2.0f), angle * 180.0 / CV_PI, 1.0);
+  straight.forward(0, 2) += (W - size.width) / 2.0;
+  straight.forward(1, 2) += (H - size.height) / 2.0;
   // Each state turned with linear interpolation, so that a turned wall stays a closed line (nearest-pixel
   // sampling breaks a thin wall into steps with gaps): a cell is a wall when walls cover a quarter of it, else
   // free when free space covers half of it, else unknown.
@@ -808,12 +809,12 @@ PredictionResult DefaultPredictor::predict(const PredictionRequest& request) con
 
   // A turned map (every SLAM map is a little) is predicted turned straight, where the layout's cells and the
   // rectangles are axis-aligned, and its rooms are turned back.
-  const double degrees = dominantWallAngle(request.map) * 180.0 / CV_PI;
+  const double angle = dominantWallAngle(request.map), degrees = angle * 180.0 / CV_PI;
   PredictionResult result;
   if (std::abs(degrees) < P.min_rotation) {
     result = roomsOnStraightMap(request, values, P);
   } else {
-    const StraightRequest straight = turnedStraight(request, degrees * CV_PI / 180.0);
+    const StraightRequest straight = turnedStraight(request, angle);
     result = roomsOnStraightMap(straight.request, values, P);
     const cv::Mat1b known = request.map.cells != common::OccupancyGrid::kUnknown;
     for (RoomPrediction& room : result.rooms) {

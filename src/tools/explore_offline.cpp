@@ -84,8 +84,6 @@ int run(int argc, char** argv) {
   run_options.simulation.seed = static_cast<uint64_t>(seed);
   run_options.mapper.config_file = config_path;
   run_options.mapper.seed = static_cast<uint32_t>(seed);
-  if (!std::filesystem::is_regular_file(config_path)) throw common::InputError(config_path, "no such file");
-  common::createOutputDirectory(out_dir);
 
   const auto start = std::chrono::steady_clock::now();
   const auto wallSeconds = [&] {
@@ -107,6 +105,8 @@ int run(int argc, char** argv) {
   const common::DoorsFile doors =
       evaluation::translateDoors(environment, open_closable, result.truth, result.estimate, door_width, true);
 
+  // Created only now: bad input (a missing or malformed ini, ...) writes nothing.
+  common::createOutputDirectory(out_dir);
   const std::filesystem::path out(out_dir);
   common::saveMap(result.map, (out / "map").string(), ".png");
   common::writeTextAtomically((out / "truth.log").string(),

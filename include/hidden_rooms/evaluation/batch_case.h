@@ -18,8 +18,9 @@ struct BatchCase {
   std::vector<int> closed_door_numbers;  // as given (closing order), 1-based door numbers
   world::HiddenRoomsCase input;          // map with the rooms erased, doors (environment order), true rooms
   double hidden_percent = 0.0;           // 100 * true room cells / free cells of the complete map
-  // Per closed door (doors file order): the true room's area in the map / its free area in the rendering with
-  // every door open. Below 1 where an explored map shows only part of the room; 1 from a rendering.
+  // Per closed door (doors file order): the true room's area in the map / its free area in the rendering (of an
+  // explored map: with every door open). Below 1 where an explored map shows only part of the room; 1 from a
+  // rendering (measured on that rendering itself).
   std::vector<double> room_coverage;
   double seconds = 0.0;                  // time to build the case
 };
