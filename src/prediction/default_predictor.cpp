@@ -262,6 +262,9 @@ void measureDepth(const Frame& f, double resolution, const DefaultOptions& P, Do
   }
   d->bounded = columns > 0 && d->bounded_depths.size() >= P.bounded_fraction * columns;
   if (d->bounded) d->depth = median(d->bounded_depths);
+  // Known space far beyond the room's proportions is no evidence of its back wall (a door into a large unknown
+  // region): the depth is then left to the priors.
+  if (d->bounded && d->depth > P.max_aspect * width) d->bounded = false;
 }
 
 // Depth of explored rooms on the same side of the same wall, within reach of the door's extent.
@@ -404,6 +407,8 @@ const common::OptionTable<DefaultOptions>& defaultOptionTable() {
       {"default_neighbour_reach", &O::neighbour_reach,
        "m: how far along the wall explored neighbours are looked for", common::atLeast(0)},
       {"default_min_depth", &O::min_depth, "m: smallest depth taken from the square prior", common::atLeast(0)},
+      {"default_max_aspect", &O::max_aspect,
+       "a depth measured on known space counts up to this many times the width", common::above(0)},
       {"default_min_rotation", &O::min_rotation, "degrees: maps turned less are not predicted turned straight",
        common::atLeast(0)},
       {"default_grown_area_ratio", &O::grown_area_ratio,

@@ -384,6 +384,33 @@ TEST(DefaultPredictor, ClipsToTheOutlineOnATurnedMap) {
   EXPECT_GT(on_turned, 0.92);
 }
 
+// A door into a large unknown region (failure pattern 2 of the unseen maps): a 4 m wide room between two wall
+// stubs of a corridor, 5 m deep, and beyond it 11 m more unknown up to a known corridor far away. That corridor
+// is no evidence of the room's back wall: measured depths beyond default_max_aspect times the width give way to
+// the priors (here the square).
+TEST(DefaultPredictor, FarKnownSpaceDoesNotSetTheDepth) {
+  Synthetic s = blankFloor(cv::Size(400, 460));
+  common::OccupancyGrid& map = s.request.map;
+  map.cells(cv::Rect(17, 393, 366, 47)).setTo(common::OccupancyGrid::kOccupied);  // around the corridor
+  map.cells(cv::Rect(20, 397, 360, 40)).setTo(common::OccupancyGrid::kFree);      // corridor, rows 397..436
+  map.cells(cv::Rect(158, 397, 4, 10)).setTo(common::OccupancyGrid::kOccupied);   // stubs at the room's walls
+  map.cells(cv::Rect(238, 397, 4, 10)).setTo(common::OccupancyGrid::kOccupied);
+  map.cells(cv::Rect(17, 17, 366, 46)).setTo(common::OccupancyGrid::kOccupied);   // around a far corridor
+  map.cells(cv::Rect(20, 20, 360, 40)).setTo(common::OccupancyGrid::kFree);       // unknown from row 63 on
+  s.truth(cv::Rect(160, 293, 80, 100)).setTo(1);  // the hidden room, rows 293..392
+  addDoor(&s, 1, 200, 394.5);
+  s.request.parameters["default_grown_area_ratio"] = 1000.0;  // the wall-fitted rectangle only
+  const auto predictor = makeRoomPredictor("default");
+  const PredictionResult result = predictor->predict(s.request);
+  const double capped = scoreOf(s, result).iou[0];
+  s.request.parameters["default_max_aspect"] = 100.0;  // any measured depth counts
+  const double uncapped = scoreOf(s, predictor->predict(s.request)).iou[0];
+  std::printf("IoU with the depth capped %.3f, uncapped %.3f\n", capped, uncapped);
+  EXPECT_EQ(result.rooms[0].terms.at("depth_bounded"), 0.0);
+  EXPECT_GT(capped, 0.75);
+  EXPECT_LT(uncapped, 0.4);
+}
+
 // Mean IoU of `default` over the benchmark's 44 valid cases; the floor sits a little under the measured mean
 // (0.724), so that a regression fails.
 TEST(DefaultPredictor, KeepsItsAccuracyOnTheBenchmark) {

@@ -19,7 +19,9 @@
 //    - doors on the same wall and the same side split their shared extent at the midpoint between them;
 //    - depth: per column of the extent, the unknown run behind the wall (past the column's own wall pixels
 //      within 0.15 m: a ragged or slightly tilted SLAM wall) up to the first known pixel; the
-//      median when enough columns end on a known pixel inside the known map's bounding box, else a prior: the
+//      median when enough columns end on a known pixel inside the known map's bounding box and it is at most
+//      default_max_aspect times the width (farther known space is no evidence of the room's back wall: a door
+//      into a large unknown region), else a prior: the
 //      depth of the explored rooms on the same side of the same wall, else of the other hidden rooms on that
 //      side, else the room's width (a square, as the thesis does).
 // 2. Overlapping rectangles of doors on perpendicular walls: the overlap goes to the door nearer to it (along
@@ -61,6 +63,7 @@ struct DefaultOptions {
   double bounded_fraction = 0.5;     // share of columns ending on a known pixel for a measured depth
   double neighbour_reach = 15.0;     // m: how far along the wall explored neighbours are looked for
   double min_depth = 2.0;            // m: smallest depth taken from the square prior
+  double max_aspect = 2.0;           // a depth measured on known space counts up to this many times the width
   double min_rotation = 1.0;         // degrees: maps turned less are not predicted turned straight
   double grown_area_ratio = 1.25;    // grown rooms less than this many times the rectangle give way
   double stub_length = 0.3;          // m: wall stubs this long into the explored side end a room's extent
