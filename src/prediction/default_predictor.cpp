@@ -409,6 +409,10 @@ const common::OptionTable<DefaultOptions>& defaultOptionTable() {
       {"default_min_depth", &O::min_depth, "m: smallest depth taken from the square prior", common::atLeast(0)},
       {"default_max_aspect", &O::max_aspect,
        "a depth measured on known space counts up to this many times the width", common::above(0)},
+      {"default_local_frame_radius", &O::local_frame_radius,
+       "m: the walls within this of a door give its frame; 0: the map's frame", common::atLeast(0)},
+      {"default_local_frame_tolerance", &O::local_frame_tolerance,
+       "degrees: doors whose wall angles differ less share one frame", common::atLeast(0)},
       {"default_min_rotation", &O::min_rotation, "degrees: maps turned less are not predicted turned straight",
        common::atLeast(0)},
       {"default_grown_area_ratio", &O::grown_area_ratio,
@@ -804,6 +808,58 @@ PredictionResult roomsOnStraightMap(const PredictionRequest& request, const std:
 
 }  // namespace
 
+namespace {
+
+// The rooms of `request` predicted on its map turned straight by `angle` (radians; not turned when under
+// min_rotation), turned back onto the map.
+PredictionResult roomsAtAngle(const PredictionRequest& request, double angle,
+                              const std::map<std::string, double>& values, const DefaultOptions& P) {
+  if (std::abs(angle * 180.0 / CV_PI) < P.min_rotation) return roomsOnStraightMap(request, values, P);
+  const StraightRequest straight = turnedStraight(request, angle);
+  PredictionResult result = roomsOnStraightMap(straight.request, values, P);
+  const cv::Mat1b known = request.map.cells != common::OccupancyGrid::kUnknown;
+  for (RoomPrediction& room : result.rooms) {
+    if (!room.placed) {
+      room.mask = cv::Mat1b::zeros(request.map.cells.size());
+      continue;
+    }
+    cv::Mat1b back;
+    cv::warpAffine(room.mask, back, cv::Mat(straight.forward), request.map.cells.size(),
+                   cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_CONSTANT, cv::Scalar(0));
+    room.mask = (back >= 128) & ~known;
+    finishPrediction(request.map, &room);
+  }
+  return result;
+}
+
+// Difference of two wall angles modulo 90 degrees, radians in [-pi/4, pi/4).
+double wallAngleDifference(double a, double b) {
+  double d = std::fmod(a - b + CV_PI / 4.0, CV_PI / 2.0);
+  if (d < 0) d += CV_PI / 2.0;
+  return d - CV_PI / 4.0;
+}
+
+// The dominant wall angle within `radius` metres of each door (dominantWallAngle of that part of the map), or
+// `global` where that part shows too few wall cells to tell.
+std::vector<double> localWallAngles(const PredictionRequest& request, double global, double radius) {
+  const common::OccupancyGrid& map = request.map;
+  const int r = static_cast<int>(std::lround(radius / map.resolution));
+  const int min_cells = std::max(20, r);  // about a wall across the window
+  std::vector<double> angles;
+  for (const common::MapDoor& door : request.doors.doors) {
+    const cv::Point p = doorPixel(map, door);
+    const cv::Rect window = cv::Rect(p.x - r, p.y - r, 2 * r + 1, 2 * r + 1) & cv::Rect(0, 0, map.width(), map.height());
+    common::OccupancyGrid part;
+    part.resolution = map.resolution;
+    if (window.area() > 0) part.cells = map.cells(window);
+    const bool enough = window.area() > 0 && cv::countNonZero(part.cells >= kOccupiedFrom) >= min_cells;
+    angles.push_back(enough ? dominantWallAngle(part) : global);
+  }
+  return angles;
+}
+
+}  // namespace
+
 PredictionResult DefaultPredictor::predict(const PredictionRequest& request) const {
   const auto start_time = std::chrono::steady_clock::now();
   checkUsableMap(request.map);
@@ -813,28 +869,41 @@ PredictionResult DefaultPredictor::predict(const PredictionRequest& request) con
   common::validateOptions(defaultOptionTable(), P, "parameter ");
 
   // A turned map (every SLAM map is a little) is predicted turned straight, where the layout's cells and the
-  // rectangles are axis-aligned, and its rooms are turned back.
-  const double angle = dominantWallAngle(request.map), degrees = angle * 180.0 / CV_PI;
+  // rectangles are axis-aligned, and its rooms are turned back. Each door in the frame of the walls around it: a
+  // wing built at another angle, or a map bent by drift, is turned straight for its own doors.
+  const double global = dominantWallAngle(request.map);
+  std::vector<double> door_angles(request.doors.doors.size(), global);
+  if (P.local_frame_radius > 0.0) door_angles = localWallAngles(request, global, P.local_frame_radius);
+  // Doors whose walls lie within local_frame_tolerance of the map's, or of each other's, share one prediction.
+  const double tolerance = P.local_frame_tolerance * CV_PI / 180.0;
+  std::vector<double> group_angles;
+  std::vector<int> group_of(door_angles.size());
+  for (size_t i = 0; i < door_angles.size(); ++i) {
+    int group = -1;
+    if (std::abs(wallAngleDifference(door_angles[i], global)) <= tolerance) door_angles[i] = global;
+    for (size_t g = 0; g < group_angles.size() && group < 0; ++g)
+      if (std::abs(wallAngleDifference(door_angles[i], group_angles[g])) <= tolerance) group = static_cast<int>(g);
+    if (group < 0) {
+      group = static_cast<int>(group_angles.size());
+      group_angles.push_back(door_angles[i]);
+    }
+    group_of[i] = group;
+  }
   PredictionResult result;
-  if (std::abs(degrees) < P.min_rotation) {
-    result = roomsOnStraightMap(request, values, P);
-  } else {
-    const StraightRequest straight = turnedStraight(request, angle);
-    result = roomsOnStraightMap(straight.request, values, P);
-    const cv::Mat1b known = request.map.cells != common::OccupancyGrid::kUnknown;
-    for (RoomPrediction& room : result.rooms) {
-      if (!room.placed) {
-        room.mask = cv::Mat1b::zeros(request.map.cells.size());
-        continue;
-      }
-      cv::Mat1b back;
-      cv::warpAffine(room.mask, back, cv::Mat(straight.forward), request.map.cells.size(),
-                     cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_CONSTANT, cv::Scalar(0));
-      room.mask = (back >= 128) & ~known;
-      finishPrediction(request.map, &room);
+  result.rooms.resize(request.doors.doors.size());
+  for (size_t g = 0; g < group_angles.size(); ++g) {
+    PredictionRequest part = request;
+    part.doors.doors.clear();
+    std::vector<size_t> members;
+    for (size_t i = 0; i < group_of.size(); ++i)
+      if (group_of[i] == static_cast<int>(g)) members.push_back(i), part.doors.doors.push_back(request.doors.doors[i]);
+    if (g > 0) part.debug_dir.clear();  // the debug images show the map's own frame
+    PredictionResult rooms = roomsAtAngle(part, group_angles[g], values, P);
+    for (size_t k = 0; k < members.size(); ++k) {
+      rooms.rooms[k].terms["rotation"] = group_angles[g] * 180.0 / CV_PI;
+      result.rooms[members[k]] = std::move(rooms.rooms[k]);
     }
   }
-  for (RoomPrediction& room : result.rooms) room.terms["rotation"] = degrees;
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
   return result;
 }

@@ -9,7 +9,10 @@
 //
 // Turned maps: when the dominant wall direction (dominantWallAngle, modulo 90 degrees) is at least
 // default_min_rotation, the whole prediction runs on the map turned straight (walls along x and y, as the
-// layout's cells and the rectangles need) with its doors, and the rooms are turned back onto the map.
+// layout's cells and the rectangles need) with its doors, and the rooms are turned back onto the map. The angle is
+// measured per door too, on the map within default_local_frame_radius of it: doors whose angle differs from the
+// map's (and from each other's) by more than default_local_frame_tolerance degrees are predicted apart, each
+// group in its own frame (a wing built at another angle, a map bent by drift).
 //
 // The rectangles, per door, in the door's frame (u along the door's wall, v into the unknown side):
 // 1. - the wall: the occupied pixels across the door; the room starts at the first unknown row behind it;
@@ -43,7 +46,7 @@
 // straight, on a turned map).
 // terms: "rectangle" (1 when the rectangle was chosen, 0 the grown room); a grown room has the thesis's terms, a
 // rectangle "width", "depth" (metres), "depth_bounded" (1 when the depth came from the map, 0 from a prior);
-// every room "rotation" (the dominant wall angle, degrees; the map was turned when it is at least
+// every room "rotation" (the wall angle its door was predicted at, degrees; the map was turned when it is at least
 // default_min_rotation), "outline_clipped" (m^2 removed by the outline clip) and, with a margin, "wall_margin"
 // (metres) and "wall_margin_cut" (m^2 removed by it).
 
@@ -64,6 +67,8 @@ struct DefaultOptions {
   double neighbour_reach = 15.0;     // m: how far along the wall explored neighbours are looked for
   double min_depth = 2.0;            // m: smallest depth taken from the square prior
   double max_aspect = 2.0;           // a depth measured on known space counts up to this many times the width
+  double local_frame_radius = 10.0;  // m: the walls within this of a door give its frame; 0: the map's frame
+  double local_frame_tolerance = 2.0;  // degrees: doors whose wall angles differ less share one frame
   double min_rotation = 1.0;         // degrees: maps turned less are not predicted turned straight
   double grown_area_ratio = 1.25;    // grown rooms less than this many times the rectangle give way
   double stub_length = 0.3;          // m: wall stubs this long into the explored side end a room's extent
