@@ -806,10 +806,6 @@ PredictionResult roomsOnStraightMap(const PredictionRequest& request, const std:
   return result;
 }
 
-}  // namespace
-
-namespace {
-
 // The rooms of `request` predicted on its map turned straight by `angle` (radians; not turned when under
 // min_rotation), turned back onto the map.
 PredictionResult roomsAtAngle(const PredictionRequest& request, double angle,
@@ -858,6 +854,30 @@ std::vector<double> localWallAngles(const PredictionRequest& request, double glo
   return angles;
 }
 
+// The frames the doors are predicted in: the map's dominant wall angle first, then each door's own angle
+// (localWallAngles) unless it lies within local_frame_tolerance of an earlier frame's.
+struct DoorFrames {
+  std::vector<double> angles;   // radians, the map's first
+  std::vector<size_t> frame_of;  // per door, its frame's index
+};
+
+DoorFrames doorFrames(const PredictionRequest& request, const DefaultOptions& P) {
+  DoorFrames frames;
+  frames.angles.push_back(dominantWallAngle(request.map));
+  frames.frame_of.assign(request.doors.doors.size(), 0);
+  if (P.local_frame_radius <= 0.0) return frames;
+  const double tolerance = P.local_frame_tolerance * CV_PI / 180.0;
+  const std::vector<double> local = localWallAngles(request, frames.angles[0], P.local_frame_radius);
+  for (size_t i = 0; i < local.size(); ++i) {
+    size_t frame = 0;
+    while (frame < frames.angles.size() && std::abs(wallAngleDifference(local[i], frames.angles[frame])) > tolerance)
+      ++frame;
+    if (frame == frames.angles.size()) frames.angles.push_back(local[i]);
+    frames.frame_of[i] = frame;
+  }
+  return frames;
+}
+
 }  // namespace
 
 PredictionResult DefaultPredictor::predict(const PredictionRequest& request) const {
@@ -869,38 +889,21 @@ PredictionResult DefaultPredictor::predict(const PredictionRequest& request) con
   common::validateOptions(defaultOptionTable(), P, "parameter ");
 
   // A turned map (every SLAM map is a little) is predicted turned straight, where the layout's cells and the
-  // rectangles are axis-aligned, and its rooms are turned back. Each door in the frame of the walls around it: a
-  // wing built at another angle, or a map bent by drift, is turned straight for its own doors.
-  const double global = dominantWallAngle(request.map);
-  std::vector<double> door_angles(request.doors.doors.size(), global);
-  if (P.local_frame_radius > 0.0) door_angles = localWallAngles(request, global, P.local_frame_radius);
-  // Doors whose walls lie within local_frame_tolerance of the map's, or of each other's, share one prediction.
-  const double tolerance = P.local_frame_tolerance * CV_PI / 180.0;
-  std::vector<double> group_angles;
-  std::vector<int> group_of(door_angles.size());
-  for (size_t i = 0; i < door_angles.size(); ++i) {
-    int group = -1;
-    if (std::abs(wallAngleDifference(door_angles[i], global)) <= tolerance) door_angles[i] = global;
-    for (size_t g = 0; g < group_angles.size() && group < 0; ++g)
-      if (std::abs(wallAngleDifference(door_angles[i], group_angles[g])) <= tolerance) group = static_cast<int>(g);
-    if (group < 0) {
-      group = static_cast<int>(group_angles.size());
-      group_angles.push_back(door_angles[i]);
-    }
-    group_of[i] = group;
-  }
+  // rectangles are axis-aligned, and its rooms are turned back; each door in the frame of the walls around it.
+  const DoorFrames frames = doorFrames(request, P);
   PredictionResult result;
   result.rooms.resize(request.doors.doors.size());
-  for (size_t g = 0; g < group_angles.size(); ++g) {
+  for (size_t g = 0; g < frames.angles.size(); ++g) {
     PredictionRequest part = request;
     part.doors.doors.clear();
     std::vector<size_t> members;
-    for (size_t i = 0; i < group_of.size(); ++i)
-      if (group_of[i] == static_cast<int>(g)) members.push_back(i), part.doors.doors.push_back(request.doors.doors[i]);
-    if (g > 0) part.debug_dir.clear();  // the debug images show the map's own frame
-    PredictionResult rooms = roomsAtAngle(part, group_angles[g], values, P);
+    for (size_t i = 0; i < frames.frame_of.size(); ++i)
+      if (frames.frame_of[i] == g) members.push_back(i), part.doors.doors.push_back(request.doors.doors[i]);
+    // The map's own frame always runs: the layout's debug images are its.
+    if (g > 0) part.debug_dir.clear();
+    PredictionResult rooms = roomsAtAngle(part, frames.angles[g], values, P);
     for (size_t k = 0; k < members.size(); ++k) {
-      rooms.rooms[k].terms["rotation"] = group_angles[g] * 180.0 / CV_PI;
+      rooms.rooms[k].terms["rotation"] = frames.angles[g] * 180.0 / CV_PI;
       result.rooms[members[k]] = std::move(rooms.rooms[k]);
     }
   }
