@@ -319,6 +319,13 @@ def format_score(value, width=8):
     return ("%.4f" % value if value is not None else "-").rjust(width)
 
 
+def score_columns(indices, cases, methods, runs, width):
+    """The mean IoU of each method and of the reference over the cases at `indices`, as columns of `width`."""
+    means = [mean_or_none([runs[method][i].mean_iou for i in indices]) for method in methods]
+    means.append(mean_or_none([cases[i].reference_iou for i in indices]))
+    return "".join(format_score(mean, width) for mean in means)
+
+
 def print_table(cases, methods, runs):
     """Mean IoU by number of closed doors: one row per number, one column per method plus the reference."""
     width = max(12, *(len(method) + 1 for method in methods))
@@ -330,12 +337,9 @@ def print_table(cases, methods, runs):
     counts = sorted({case.doors for case in cases} | set(range(1, MAX_DOORS_ROW + 1)))
     for doors in counts:
         indices = [i for i, case in enumerate(cases) if case.doors == doors]
-        line = "%5d  %5d" % (doors, len(indices))
-        for method in methods:
-            line += format_score(mean_or_none([runs[method][i].mean_iou for i in indices]), width)
         references = [cases[i].reference_iou for i in indices if cases[i].reference_iou is not None]
-        line += format_score(mean_or_none(references), width) + ("%10d" % len(references))
-        print(line)
+        print("%5d  %5d" % (doors, len(indices)) + score_columns(indices, cases, methods, runs, width) +
+              "%10d" % len(references))
     print()
 
 
@@ -356,10 +360,7 @@ def print_environments(cases, methods, runs):
         if with_parts:
             line += "  " + cases[indices[0]].part.ljust(10)
         line += "  %5d" % len(indices)
-        for method in methods:
-            line += format_score(mean_or_none([runs[method][i].mean_iou for i in indices]), width)
-        line += format_score(mean_or_none([cases[i].reference_iou for i in indices]), width)
-        print(line)
+        print(line + score_columns(indices, cases, methods, runs, width))
     print()
 
 
