@@ -352,15 +352,14 @@ void clipToKnownOutline(const cv::Mat1b& known, const cv::Point& door, int reach
   (*mask)(room).setTo(0, outside);
 }
 
-double dominantWallAngle(const common::OccupancyGrid& map) {
+double dominantWallAngle(const common::OccupancyGrid& map, size_t max_points) {
   // The projection profiles of the wall pixels: turned by the walls' angle, the pixels of each wall fall into a
   // few rows or columns, so the profiles along both axes are sharpest (their sums of squared counts largest).
   // Robust to the staircase a turned wall is rasterized into, which biases gradient directions towards 0.
   std::vector<cv::Point> cells;
   cv::findNonZero(map.cells >= kOccupiedFrom, cells);
   if (cells.empty()) return 0.0;
-  constexpr size_t kMaxPoints = 20000;  // evenly thinned beyond this: the profiles keep their shape
-  const size_t stride = cells.size() / kMaxPoints + 1;
+  const size_t stride = cells.size() / std::max<size_t>(1, max_points) + 1;  // evenly thinned: same profiles
   std::vector<cv::Point2d> points;
   for (size_t k = 0; k < cells.size(); k += stride) points.emplace_back(cells[k].x, cells[k].y);
   const double diagonal = std::hypot(map.width(), map.height());
@@ -835,6 +834,8 @@ double wallAngleDifference(double a, double b) {
   return d - CV_PI / 4.0;
 }
 
+constexpr size_t kLocalAnglePoints = 2000;  // wall cells a door's angle is measured on (evenly thinned beyond)
+
 // The dominant wall angle within `radius` metres of each door (dominantWallAngle of that part of the map), or
 // `global` where that part shows too few wall cells to tell.
 std::vector<double> localWallAngles(const PredictionRequest& request, double global, double radius) {
@@ -849,7 +850,7 @@ std::vector<double> localWallAngles(const PredictionRequest& request, double glo
     part.resolution = map.resolution;
     if (window.area() > 0) part.cells = map.cells(window);
     const bool enough = window.area() > 0 && cv::countNonZero(part.cells >= kOccupiedFrom) >= min_cells;
-    angles.push_back(enough ? dominantWallAngle(part) : global);
+    angles.push_back(enough ? dominantWallAngle(part, kLocalAnglePoints) : global);
   }
   return angles;
 }
