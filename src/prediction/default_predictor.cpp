@@ -834,6 +834,7 @@ double wallAngleDifference(double a, double b) {
   return d - CV_PI / 4.0;
 }
 
+constexpr size_t kMaxFrames = 8;
 constexpr size_t kLocalAnglePoints = 2000;  // wall cells a door's angle is measured on (evenly thinned beyond)
 
 // The dominant wall angle within `radius` metres of each door (dominantWallAngle of that part of the map), or
@@ -856,7 +857,9 @@ std::vector<double> localWallAngles(const PredictionRequest& request, double glo
 }
 
 // The frames the doors are predicted in: the map's dominant wall angle first, then each door's own angle
-// (localWallAngles) unless it lies within local_frame_tolerance of an earlier frame's.
+// (localWallAngles) unless it lies within local_frame_tolerance of an earlier frame's; a door joins the nearest
+// frame. At most kMaxFrames frames (each is a whole prediction): a building has a few wall directions, and a
+// drifted map a few parts.
 struct DoorFrames {
   std::vector<double> angles;   // radians, the map's first
   std::vector<size_t> frame_of;  // per door, its frame's index
@@ -870,11 +873,17 @@ DoorFrames doorFrames(const PredictionRequest& request, const DefaultOptions& P)
   const double tolerance = P.local_frame_tolerance * CV_PI / 180.0;
   const std::vector<double> local = localWallAngles(request, frames.angles[0], P.local_frame_radius);
   for (size_t i = 0; i < local.size(); ++i) {
-    size_t frame = 0;
-    while (frame < frames.angles.size() && std::abs(wallAngleDifference(local[i], frames.angles[frame])) > tolerance)
-      ++frame;
-    if (frame == frames.angles.size()) frames.angles.push_back(local[i]);
-    frames.frame_of[i] = frame;
+    size_t nearest = 0;
+    for (size_t frame = 1; frame < frames.angles.size(); ++frame)
+      if (std::abs(wallAngleDifference(local[i], frames.angles[frame])) <
+          std::abs(wallAngleDifference(local[i], frames.angles[nearest])))
+        nearest = frame;
+    const bool apart = std::abs(wallAngleDifference(local[i], frames.angles[nearest])) > tolerance;
+    if (apart && frames.angles.size() < kMaxFrames) {
+      nearest = frames.angles.size();
+      frames.angles.push_back(local[i]);
+    }
+    frames.frame_of[i] = nearest;
   }
   return frames;
 }
