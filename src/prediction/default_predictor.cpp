@@ -834,7 +834,7 @@ double wallAngleDifference(double a, double b) {
   return d - CV_PI / 4.0;
 }
 
-constexpr size_t kMaxFrames = 8;
+constexpr size_t kMaxFrames = 8;  // frames of one prediction at most (predictionFrames)
 constexpr size_t kLocalAnglePoints = 2000;  // wall cells a door's angle is measured on (evenly thinned beyond)
 
 // The dominant wall angle within `radius` metres of each door (dominantWallAngle of that part of the map), or
@@ -857,16 +857,16 @@ std::vector<double> localWallAngles(const PredictionRequest& request, double glo
 }
 
 // The frames the doors are predicted in: the map's dominant wall angle first, then each door's own angle
-// (localWallAngles) unless it lies within local_frame_tolerance of an earlier frame's; a door joins the nearest
-// frame. At most kMaxFrames frames (each is a whole prediction): a building has a few wall directions, and a
-// drifted map a few parts.
-struct DoorFrames {
+// (localWallAngles) when it lies more than local_frame_tolerance from every frame so far, up to kMaxFrames frames
+// (each is a whole prediction: a building has a few wall directions, a drifted map a few parts); otherwise the
+// door joins the frame nearest to its angle.
+struct PredictionFrames {
   std::vector<double> angles;   // radians, the map's first
   std::vector<size_t> frame_of;  // per door, its frame's index
 };
 
-DoorFrames doorFrames(const PredictionRequest& request, const DefaultOptions& P) {
-  DoorFrames frames;
+PredictionFrames predictionFrames(const PredictionRequest& request, const DefaultOptions& P) {
+  PredictionFrames frames;
   frames.angles.push_back(dominantWallAngle(request.map));
   frames.frame_of.assign(request.doors.doors.size(), 0);
   if (P.local_frame_radius <= 0.0) return frames;
@@ -900,7 +900,7 @@ PredictionResult DefaultPredictor::predict(const PredictionRequest& request) con
 
   // A turned map (every SLAM map is a little) is predicted turned straight, where the layout's cells and the
   // rectangles are axis-aligned, and its rooms are turned back; each door in the frame of the walls around it.
-  const DoorFrames frames = doorFrames(request, P);
+  const PredictionFrames frames = predictionFrames(request, P);
   PredictionResult result;
   result.rooms.resize(request.doors.doors.size());
   for (size_t g = 0; g < frames.angles.size(); ++g) {
