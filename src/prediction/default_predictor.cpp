@@ -909,8 +909,9 @@ PredictionResult DefaultPredictor::predict(const PredictionRequest& request) con
     std::vector<size_t> members;
     for (size_t i = 0; i < frames.frame_of.size(); ++i)
       if (frames.frame_of[i] == g) members.push_back(i), part.doors.doors.push_back(request.doors.doors[i]);
-    // The map's own frame always runs: the layout's debug images are its.
+    // The layout's debug images are those of the map's own frame, which runs for them even without doors.
     if (g > 0) part.debug_dir.clear();
+    if (members.empty() && part.debug_dir.empty()) continue;
     PredictionResult rooms = roomsAtAngle(part, frames.angles[g], values, P);
     for (size_t k = 0; k < members.size(); ++k) {
       rooms.rooms[k].terms["rotation"] = frames.angles[g] * 180.0 / CV_PI;
