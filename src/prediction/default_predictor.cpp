@@ -1,4 +1,5 @@
 #include "hidden_rooms/prediction/default_predictor.h"
+#include "hidden_rooms/prediction/room_network.h"
 
 #include <algorithm>
 #include <chrono>
@@ -21,6 +22,7 @@ namespace {
 constexpr uint8_t kUnknownPx = 0, kFreePx = 1, kOccupiedPx = 2;
 constexpr int8_t kOccupiedFrom = 50;
 constexpr double kWallDrift = 0.15;  // m: how far past the door's first unknown row a tilted wall may reach
+constexpr int kNetworkDoorReach = 3;  // pixels: the learned model's room touches its door's disc grown by this
 
 cv::Mat1b statesOf(const common::OccupancyGrid& map) {
   cv::Mat1b states(map.cells.size(), kUnknownPx);
@@ -423,6 +425,8 @@ const common::OptionTable<DefaultOptions>& defaultOptionTable() {
       {"default_wall_margin", &O::wall_margin,
        "m: unseen wall thickness left out of rooms; < 0: estimated from the map",
        {-std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(), false, false}},
+      {"default_network", &O::network,
+       "learned room model: 0 unused; 1 chooses rectangle or grown room; 2 its rooms", {0, 2, false, false, true}},
   };
   return table;
 }
@@ -747,14 +751,41 @@ PredictionResult roomsOnStraightMap(const PredictionRequest& request, const std:
 
   std::vector<RoomPrediction> grown = growth.get().rooms;
 
-  // Per door: the grown room, unless it is much smaller than the rectangle (it stopped short of the walls the
-  // rectangle found) or missing; a rectangle gives up the pixels of the grown rooms kept for other doors.
+  // The learned model's room per door (room_network.h), when it chooses or replaces them.
+  std::vector<NetworkRoom> network_rooms;
+  if (P.network > 0) {
+    std::vector<NetworkDoor> network_doors;
+    for (const common::MapDoor& door : request.doors.doors)
+      network_doors.push_back({doorPixel(request.map, door), door.width});
+    network_rooms = networkRooms(states, network_doors, roomScores(states, resolution, network_doors), resolution,
+                                 kNetworkDoorReach);
+  }
+  // IoU of a room with the model's room of door i (-1 for a missing room).
+  const auto agreement = [&](const RoomPrediction& room, size_t i) {
+    if (!room.placed) return -1.0;
+    const NetworkRoom& seen = network_rooms[i];
+    const double both = seen.box.area() > 0 ? cv::countNonZero(room.mask(seen.box) & seen.mask) : 0;
+    const double either = cv::countNonZero(room.mask) + cv::countNonZero(seen.mask) - both;
+    return either > 0 ? both / either : 0.0;
+  };
+
+  // Per door: the rectangle or the grown room (the header's rule for each default_network), the one present
+  // when the other is missing; a rectangle gives up the pixels of the grown rooms kept for other doors.
   const size_t count = rectangles.size();
   std::vector<bool> use_rectangle(count, false);
   std::vector<cv::Rect> boxes(count);  // bounding box of each chosen room: every later step only removes cells
   cv::Mat1b kept_grown = cv::Mat1b::zeros(request.map.cells.size());
   for (size_t i = 0; i < count; ++i) {
-    use_rectangle[i] = rectangles[i].placed && grown[i].area < P.grown_area_ratio * rectangles[i].area;
+    if (P.network == 2) {
+      grown[i].terms.clear();  // the model's room, not the grown one
+      grown[i].mask = cv::Mat1b::zeros(request.map.cells.size());
+      if (network_rooms[i].box.area() > 0) network_rooms[i].mask.copyTo(grown[i].mask(network_rooms[i].box));
+      finishPrediction(request.map, &grown[i], network_rooms[i].box);
+    } else if (P.network == 1) {
+      use_rectangle[i] = rectangles[i].placed && agreement(rectangles[i], i) > agreement(grown[i], i);
+    } else {
+      use_rectangle[i] = rectangles[i].placed && grown[i].area < P.grown_area_ratio * rectangles[i].area;
+    }
     const RoomPrediction& room = use_rectangle[i] ? rectangles[i] : grown[i];
     if (room.placed) boxes[i] = cv::boundingRect(room.mask);
     if (!use_rectangle[i] && grown[i].placed) kept_grown(boxes[i]) |= grown[i].mask(boxes[i]);

@@ -112,7 +112,7 @@ TEST(DefaultPredictor, MeasuresDepthBehindARaggedWall) {
   for (int col = 40; col < 140; ++col)
     if ((col < 78 || col > 102) && col % 4 != 0) s.request.map.cells(96, col) = common::OccupancyGrid::kOccupied;
   s.truth.setTo(0, s.request.map.cells != common::OccupancyGrid::kUnknown);
-  s.request.parameters = {{"default_grown_area_ratio", 1e9}};  // the rectangles only
+  s.request.parameters = {{"default_network", 0}, {"default_grown_area_ratio", 1e9}};  // the rectangles only
   const PredictionResult result = makeRoomPredictor("default")->predict(s.request);
   EXPECT_NEAR(result.rooms[0].terms.at("depth"), 76 * 0.05, 0.1);
   EXPECT_GT(scoreOf(s, result).iou[0], 0.8);
@@ -190,11 +190,27 @@ Synthetic corridorWithPillar() {
 
 TEST(DefaultPredictor, WallStubsEndTheRoomsAlongTheirWall) {
   Synthetic s = corridorWithPillar();
+  s.request.parameters["default_network"] = 0;  // the area rule, with:
   s.request.parameters["default_grown_area_ratio"] = 1000.0;  // the wall-fitted rectangles only
   const evaluation::RoomScores with_stubs = scoreOf(s, makeRoomPredictor("default")->predict(s.request));
   for (size_t k = 0; k < with_stubs.iou.size(); ++k) EXPECT_GT(with_stubs.iou[k], 0.9) << "door " << k + 1;
   s.request.parameters["default_stub_length"] = 0.0;  // stubs ignored: cut halfway between the doors
   EXPECT_LT(scoreOf(s, makeRoomPredictor("default")->predict(s.request)).iou[0], 0.8);
+}
+
+// Rectangle or grown room: the learned room model (default_network 1) keeps the one agreeing more with the room it
+// sees; by area alone (default_network 0), door 2 gets its grown room, at least 1.25 times its rectangle and worse.
+TEST(DefaultPredictor, TheLearnedModelChoosesBetweenRectangleAndGrownRoom) {
+  Synthetic s = corridorWithPillar();
+  const PredictionResult chosen = makeRoomPredictor("default")->predict(s.request);
+  const double by_model = scoreOf(s, chosen).iou[1];
+  s.request.parameters["default_network"] = 0;
+  const PredictionResult by_area_rule = makeRoomPredictor("default")->predict(s.request);
+  const double by_area = scoreOf(s, by_area_rule).iou[1];
+  std::printf("door 2: IoU %.3f chosen by the learned model (rectangle %g), %.3f by area (rectangle %g)\n", by_model,
+              chosen.rooms[1].terms.at("rectangle"), by_area, by_area_rule.rooms[1].terms.at("rectangle"));
+  EXPECT_GT(by_model, 0.95);
+  EXPECT_LT(by_area, 0.8);
 }
 
 // A map drawn from a state image (0 unknown, 1 free, 2 wall) with doors on horizontal walls (image column, row).
@@ -233,6 +249,7 @@ TEST(DefaultPredictor, NicheSideWallsAreNotStubs) {
   truth(cv::Rect(20, 20, 200, 75)).setTo(1);
   truth.setTo(0, states != 0);
   Synthetic s = syntheticFromStates(states, truth, {{110, 90}});
+  s.request.parameters["default_network"] = 0;  // the area rule, with:
   s.request.parameters["default_grown_area_ratio"] = 1000.0;  // the wall-fitted rectangle only
   EXPECT_GT(scoreOf(s, makeRoomPredictor("default")->predict(s.request)).iou[0], 0.9);
 }
@@ -256,6 +273,7 @@ TEST(DefaultPredictor, OverlapOfPerpendicularDoorsGoesToTheNearerDoor) {
   truth(cv::Rect(48, 133, 172, 87)).setTo(2);   // behind the west door: rows 133..219, the block's width
   Synthetic s = syntheticFromStates(states, truth, {{165, 46}, {46, 190}});
   s.request.doors.doors[1].orientation = common::DoorOrientation::kAlongY;
+  s.request.parameters["default_network"] = 0;  // the area rule, with:
   s.request.parameters["default_grown_area_ratio"] = 1000.0;  // the wall-fitted rectangles only
   const evaluation::RoomScores scores = scoreOf(s, makeRoomPredictor("default")->predict(s.request));
   for (size_t k = 0; k < scores.iou.size(); ++k) EXPECT_GT(scores.iou[k], 0.9) << "door " << k + 1;
@@ -446,6 +464,7 @@ TEST(DefaultPredictor, FarKnownSpaceDoesNotSetTheDepth) {
   map.cells(cv::Rect(20, 20, 360, 40)).setTo(common::OccupancyGrid::kFree);       // unknown from row 63 on
   s.truth(cv::Rect(160, 293, 80, 100)).setTo(1);  // the hidden room, rows 293..392
   addDoor(&s, 1, 200, 394.5);
+  s.request.parameters["default_network"] = 0;  // the area rule, with:
   s.request.parameters["default_grown_area_ratio"] = 1000.0;  // the wall-fitted rectangle only
   const auto predictor = makeRoomPredictor("default");
   const PredictionResult result = predictor->predict(s.request);

@@ -2,8 +2,10 @@
 
 // The project's own prediction method, "default": per closed door, a rectangle fitted to the walls the robot saw
 // around the door, or the room grown on the layout's cell grid by the thesis's method (thesis_predictor.h, with
-// its default parameters) when that room is at least default_grown_area_ratio times the rectangle (the
-// rectangle stopped short, e.g. of an L-shaped room) or the rectangle is missing. A rectangle gives up
+// its default parameters), whichever agrees more (IoU) with the room the learned room model sees behind the door
+// (room_network.h; default_network 1), or the rectangle is missing. Without the model (default_network 0) the
+// grown room is chosen when it is at least default_grown_area_ratio times the rectangle (the rectangle stopped
+// short, e.g. of an L-shaped room); with default_network 2 the model's rooms replace both. A rectangle gives up
 // the pixels of the grown rooms kept for the other doors. The growth runs on a second thread while the
 // rectangles are fitted (predict() is still safe to call from several threads).
 //
@@ -44,7 +46,8 @@
 // Parameters: start_search_radius and the default_* keys (config/prediction.yaml), and the layout's
 // (config/layout.yaml) for the grown rooms; --debug-dir receives the layout's images (of the map turned
 // straight, on a turned map).
-// terms: "rectangle" (1 when the rectangle was chosen, 0 the grown room); a grown room has the thesis's terms, a
+// terms: "rectangle" (1 when the rectangle was chosen, 0 the grown room or, with default_network 2, the learned
+// model's room, which has no terms of its own); a grown room has the thesis's terms, a
 // rectangle "width", "depth" (metres), "depth_bounded" (1 when the depth came from the map, 0 from a prior);
 // every room "rotation" (the wall angle its door was predicted at, degrees; the map was turned when it is at least
 // default_min_rotation), "outline_clipped" (m^2 removed by the outline clip) and, with a margin, "wall_margin"
@@ -70,10 +73,11 @@ struct DefaultOptions {
   double local_frame_radius = 10.0;  // m: the walls within this of a door give its frame; 0: the map's frame
   double local_frame_tolerance = 2.0;  // degrees: doors whose wall angles differ less share one frame
   double min_rotation = 1.0;         // degrees: maps turned less are not predicted turned straight
-  double grown_area_ratio = 1.25;    // grown rooms less than this many times the rectangle give way
+  double grown_area_ratio = 1.25;    // network 0: grown rooms less than this many times the rectangle give way
   double stub_length = 0.3;          // m: wall stubs this long into the explored side end a room's extent
   double outline_reach = 15.0;       // m: band beside a room within which the known map's extent bounds it
   double wall_margin = -1.0;         // m: unseen wall thickness left out of rooms; < 0: estimated from the map
+  int network = 1;                   // the learned room model: 0 unused; 1 chooses rectangle or grown room; 2 its rooms
 };
 
 // Every DefaultOptions field as a parameter (start_search_radius, default_wall_gap, ...) with its range.
