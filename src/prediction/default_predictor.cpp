@@ -751,9 +751,11 @@ PredictionResult roomsOnStraightMap(const PredictionRequest& request, const std:
 
   std::vector<RoomPrediction> grown = growth.get().rooms;
 
-  // The learned model's room per door (room_network.h), when it chooses or replaces them.
+  // The learned model's room per door (room_network.h), when it chooses or replaces them; on maps too fine for
+  // it the area rule decides.
+  const int network = networkReads(resolution) ? P.network : 0;
   std::vector<NetworkRoom> network_rooms;
-  if (P.network > 0) {
+  if (network > 0) {
     std::vector<NetworkDoor> network_doors;
     for (const common::MapDoor& door : request.doors.doors)
       network_doors.push_back({doorPixel(request.map, door), door.width});
@@ -776,12 +778,12 @@ PredictionResult roomsOnStraightMap(const PredictionRequest& request, const std:
   std::vector<cv::Rect> boxes(count);  // bounding box of each chosen room: every later step only removes cells
   cv::Mat1b kept_grown = cv::Mat1b::zeros(request.map.cells.size());
   for (size_t i = 0; i < count; ++i) {
-    if (P.network == 2) {
+    if (network == 2) {
       grown[i].terms.clear();  // the model's room, not the grown one
       grown[i].mask = cv::Mat1b::zeros(request.map.cells.size());
       if (network_rooms[i].box.area() > 0) network_rooms[i].mask.copyTo(grown[i].mask(network_rooms[i].box));
       finishPrediction(request.map, &grown[i], network_rooms[i].box);
-    } else if (P.network == 1) {
+    } else if (network == 1) {
       use_rectangle[i] = rectangles[i].placed && agreement(rectangles[i], i) > agreement(grown[i], i);
     } else {
       use_rectangle[i] = rectangles[i].placed && grown[i].area < P.grown_area_ratio * rectangles[i].area;

@@ -51,7 +51,11 @@ cv::Rect windowAround(const cv::Point& pixel, int side) { return {pixel.x - side
 
 }  // namespace
 
-int windowPixels(double resolution) { return std::max(1, roundHalfEven(kWindowCells * kWindowCellSize / resolution)); }
+int windowPixels(double resolution) {
+  return static_cast<int>(std::clamp(std::nearbyint(kWindowCells * kWindowCellSize / resolution), 1.0, 1e9));
+}
+
+bool networkReads(double resolution) { return windowPixels(resolution) <= kMaxWindowPixels; }
 
 cv::Mat doorWindowInput(const cv::Mat1b& states, double resolution, const std::vector<NetworkDoor>& doors,
                         size_t index) {

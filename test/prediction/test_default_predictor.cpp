@@ -12,6 +12,7 @@
 #include "hidden_rooms/evaluation/evaluation.h"
 #include "hidden_rooms/prediction/default_predictor.h"
 #include "hidden_rooms/prediction/prediction_support.h"
+#include "hidden_rooms/prediction/room_network.h"
 #include "hidden_rooms/prediction/room_predictor.h"
 #include "test_util.h"
 
@@ -211,6 +212,24 @@ TEST(DefaultPredictor, TheLearnedModelChoosesBetweenRectangleAndGrownRoom) {
               chosen.rooms[1].terms.at("rectangle"), by_area, by_area_rule.rooms[1].terms.at("rectangle"));
   EXPECT_GT(by_model, 0.95);
   EXPECT_LT(by_area, 0.8);
+}
+
+// The learned model does not read maps finer than its window allows (9.4 mm; their windows would take gigabytes):
+// there the area rule decides, as with default_network 0.
+TEST(DefaultPredictor, MapsTooFineForTheLearnedModelUseTheAreaRule) {
+  Synthetic s = corridorWithPillar();
+  constexpr int kFactor = 6;  // the same map in pixels of 8.3 mm
+  cv::resize(s.request.map.cells, s.request.map.cells, cv::Size(), kFactor, kFactor, cv::INTER_NEAREST);
+  s.request.map.resolution /= kFactor;
+  ASSERT_FALSE(networkReads(s.request.map.resolution));
+  const PredictionResult by_default = makeRoomPredictor("default")->predict(s.request);
+  s.request.parameters["default_network"] = 0;
+  const PredictionResult by_area = makeRoomPredictor("default")->predict(s.request);
+  ASSERT_EQ(by_default.rooms.size(), by_area.rooms.size());
+  for (size_t i = 0; i < by_area.rooms.size(); ++i) {
+    EXPECT_TRUE(by_area.rooms[i].placed) << by_area.rooms[i].problem;
+    EXPECT_EQ(cv::countNonZero(by_default.rooms[i].mask != by_area.rooms[i].mask), 0) << "door " << i + 1;
+  }
 }
 
 // A map drawn from a state image (0 unknown, 1 free, 2 wall) with doors on horizontal walls (image column, row).

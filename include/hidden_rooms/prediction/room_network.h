@@ -36,6 +36,11 @@ struct RoomScores {
 // Side of a door's window in map pixels at `resolution` metres per pixel.
 int windowPixels(double resolution);
 
+// Whether the model reads maps of `resolution`: its windows take at most kMaxWindowPixels pixels a side (maps
+// finer than about 9.4 mm are not read; their windows would take gigabytes).
+constexpr int kMaxWindowPixels = 2048;
+bool networkReads(double resolution);
+
 // The model's input for door `index` of `doors` on the working states image `states` (0 unknown, 1 free,
 // 2 occupied per pixel): kWindowChannels x kWindowCells x kWindowCells, channel-major, shares in [0, 1].
 cv::Mat doorWindowInput(const cv::Mat1b& states, double resolution, const std::vector<NetworkDoor>& doors,
