@@ -2,13 +2,13 @@
 
 // The project's own prediction method, "default": per closed door, a rectangle fitted to the walls the robot saw
 // around the door, or the room grown on the layout's cell grid by the thesis's method (thesis_predictor.h, with
-// its default parameters), whichever agrees more (IoU) with the room the learned room model sees behind the door
-// (room_network.h; default_network 1; on maps too fine for the model, see networkReads, the area rule below), or
-// the rectangle is missing. Without the model (default_network 0) the
-// grown room is chosen when it is at least default_grown_area_ratio times the rectangle (the rectangle stopped
-// short, e.g. of an L-shaped room); with default_network 2 the model's rooms replace both. A rectangle gives up
-// the pixels of the grown rooms kept for the other doors. The growth runs on a second thread while the
-// rectangles are fitted (predict() is still safe to call from several threads).
+// its default parameters): whichever agrees more (IoU) with the room the learned room model sees behind the door
+// (room_network.h; default_network 1), the grown room when the rectangle is missing. Without the model
+// (default_network 0, and on maps too fine for it: networkReads) the grown room is chosen when it is at least
+// default_grown_area_ratio times the rectangle (the rectangle stopped short, e.g. of an L-shaped room); with
+// default_network 2 the model's rooms replace both. A rectangle gives up the pixels of the grown rooms kept for
+// the other doors. The growth runs on a second thread while the rectangles are fitted (predict() is still safe to
+// call from several threads).
 //
 // Turned maps: when the dominant wall direction (dominantWallAngle, modulo 90 degrees) is at least
 // default_min_rotation, the whole prediction runs on the map turned straight (walls along x and y, as the
