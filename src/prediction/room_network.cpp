@@ -26,6 +26,9 @@ constexpr uint8_t kUnknownState = 0, kFreeState = 1, kOccupiedState = 2;
 // Rounding as the training code's (Python's round: halves to even), so that both draw the same windows.
 int roundHalfEven(double value) { return static_cast<int>(std::nearbyint(value)); }
 
+// Radius in pixels of a door's disc: half its width (`width` metres), at least one pixel.
+int discRadius(double width, double resolution) { return std::max(1, roundHalfEven(width / 2.0 / resolution)); }
+
 // A 0/255 mask as the share of each window cell.
 cv::Mat1f toCells(const cv::Mat1b& mask) {
   cv::Mat1f shares;
@@ -67,7 +70,7 @@ cv::Mat doorWindowInput(const cv::Mat1b& states, double resolution, const std::v
 
   cv::Mat1b this_door = cv::Mat1b::zeros(side, side), other_doors = cv::Mat1b::zeros(side, side);
   for (size_t i = 0; i < doors.size(); ++i) {
-    const int radius = std::max(1, roundHalfEven(doors[i].width / 2.0 / resolution));
+    const int radius = discRadius(doors[i].width, resolution);
     const cv::Point centre = doors[i].pixel - window.tl();
     if (std::abs(centre.x - side / 2) > side + radius || std::abs(centre.y - side / 2) > side + radius) continue;
     cv::circle(i == index ? this_door : other_doors, centre, radius, 255, cv::FILLED);
@@ -143,7 +146,7 @@ std::vector<NetworkRoom> networkRooms(const cv::Mat1b& states, const std::vector
     cv::Mat1i components;
     const int count = cv::connectedComponents(candidate, components, 4, CV_32S);
     cv::Mat1b disc = cv::Mat1b::zeros(room.box.size());
-    const int radius = std::max(1, roundHalfEven(doors[i].width / 2.0 / resolution)) + reach;
+    const int radius = discRadius(doors[i].width, resolution) + reach;
     cv::circle(disc, doors[i].pixel - room.box.tl(), radius, 255, cv::FILLED);
     std::vector<bool> touching(count, false);
     for (int y = 0; y < disc.rows; ++y)
