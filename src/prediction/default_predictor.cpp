@@ -426,9 +426,27 @@ const common::OptionTable<DefaultOptions>& defaultOptionTable() {
        "m: unseen wall thickness left out of rooms; < 0: estimated from the map",
        {-std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(), false, false}},
       {"default_network", &O::network,
-       "learned room model: 0 unused; 1 chooses rectangle or grown room; 2 its rooms", {0, 2, false, false, true}},
+       "learned room model: 0 unused; 1 chooses rectangle or grown room; 2 its rooms; 3 the candidate room agreeing "
+       "most with the other two",
+       {0, 3, false, false, true}},
   };
   return table;
+}
+
+RoomCandidate mostAgreedCandidate(const CandidateAgreement& iou, const std::array<bool, 3>& present) {
+  const std::array<double, 3> votes = {iou.rectangle_grown + iou.rectangle_model,
+                                       iou.rectangle_grown + iou.grown_model,
+                                       iou.rectangle_model + iou.grown_model};
+  RoomCandidate chosen = RoomCandidate::kGrown;  // ties: the grown room, then the rectangle
+  double best = present[1] ? votes[1] : -1.0;
+  for (const RoomCandidate candidate : {RoomCandidate::kRectangle, RoomCandidate::kModel}) {
+    const size_t k = static_cast<size_t>(candidate);
+    if (present[k] && votes[k] > best) {
+      best = votes[k];
+      chosen = candidate;
+    }
+  }
+  return chosen;
 }
 
 std::map<std::string, double> DefaultPredictor::defaultParameters() const {
@@ -638,6 +656,12 @@ std::vector<cv::Mat1b> roomMasks(const Frame& f, const std::vector<DoorFrame>& d
   return masks;
 }
 
+// |a ∩ b| / |a ∪ b| of two masks of one size (0 when both are empty).
+double maskIoU(const cv::Mat1b& a, const cv::Mat1b& b) {
+  const double either = cv::countNonZero(a | b);
+  return either > 0 ? cv::countNonZero(a & b) / either : 0.0;
+}
+
 // The rooms, one per door of the request: the masks without the map's known cells (`map_known`, 255), with the
 // rectangle's terms; unplaced doors get an empty room with their problem.
 std::vector<RoomPrediction> mapFrameRooms(const PredictionRequest& request, const std::vector<DoorFrame>& doors,
@@ -770,19 +794,34 @@ PredictionResult roomsOnStraightMap(const PredictionRequest& request, const std:
     const double either = cv::countNonZero(room.mask) + cv::countNonZero(seen.mask) - both;
     return either > 0 ? both / either : 0.0;
   };
+  // Door i's grown room replaced by the model's room (which has no terms of its own).
+  std::vector<bool> use_model(rectangles.size(), false);
+  const auto take_model_room = [&](size_t i) {
+    use_model[i] = true;
+    grown[i].terms.clear();
+    grown[i].mask = cv::Mat1b::zeros(request.map.cells.size());
+    if (network_rooms[i].box.area() > 0) network_rooms[i].mask.copyTo(grown[i].mask(network_rooms[i].box));
+    finishPrediction(request.map, &grown[i], network_rooms[i].box);
+  };
 
-  // Per door: the rectangle or the grown room (the header's rule for each default_network), the one present
-  // when the other is missing; a rectangle gives up the pixels of the grown rooms kept for other doors.
+  // Per door: the rectangle, the grown room or the model's room (the header's rule for each default_network),
+  // never a missing one; a rectangle gives up the pixels of the grown rooms kept for other doors.
   const size_t count = rectangles.size();
   std::vector<bool> use_rectangle(count, false);
   std::vector<cv::Rect> boxes(count);  // bounding box of each chosen room: every later step only removes cells
   cv::Mat1b kept_grown = cv::Mat1b::zeros(request.map.cells.size());
   for (size_t i = 0; i < count; ++i) {
-    if (network == 2) {
-      grown[i].terms.clear();  // the model's room, not the grown one
-      grown[i].mask = cv::Mat1b::zeros(request.map.cells.size());
-      if (network_rooms[i].box.area() > 0) network_rooms[i].mask.copyTo(grown[i].mask(network_rooms[i].box));
-      finishPrediction(request.map, &grown[i], network_rooms[i].box);
+    if (network == 3) {
+      CandidateAgreement iou;
+      if (rectangles[i].placed && grown[i].placed) iou.rectangle_grown = maskIoU(rectangles[i].mask, grown[i].mask);
+      iou.rectangle_model = std::max(0.0, agreement(rectangles[i], i));
+      iou.grown_model = std::max(0.0, agreement(grown[i], i));
+      const bool has_model_room = !network_rooms[i].mask.empty() && cv::countNonZero(network_rooms[i].mask) > 0;
+      const RoomCandidate chosen = mostAgreedCandidate(iou, {rectangles[i].placed, grown[i].placed, has_model_room});
+      if (chosen == RoomCandidate::kModel) take_model_room(i);
+      use_rectangle[i] = chosen == RoomCandidate::kRectangle;
+    } else if (network == 2) {
+      take_model_room(i);
     } else if (network == 1) {
       use_rectangle[i] = rectangles[i].placed && agreement(rectangles[i], i) > agreement(grown[i], i);
     } else {
@@ -833,6 +872,7 @@ PredictionResult roomsOnStraightMap(const PredictionRequest& request, const std:
       finishPrediction(request.map, &room, box);
     }
     room.terms["rectangle"] = use_rectangle[i] ? 1.0 : 0.0;
+    room.terms["model_room"] = use_model[i] ? 1.0 : 0.0;
     result.rooms.push_back(std::move(room));
   }
   return result;

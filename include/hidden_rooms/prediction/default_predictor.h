@@ -1,12 +1,13 @@
 #pragma once
 
-// The project's own prediction method, "default": per closed door, a rectangle fitted to the walls the robot saw
-// around the door, or the room grown on the layout's cell grid by the thesis's method (thesis_predictor.h, with
-// its default parameters): whichever agrees more (IoU) with the room the learned room model sees behind the door
-// (room_network.h; default_network 1), the grown room when the rectangle is missing. Without the model
-// (default_network 0, and on maps too fine for it: networkReads) the grown room is chosen when it is at least
-// default_grown_area_ratio times the rectangle (the rectangle stopped short, e.g. of an L-shaped room); with
-// default_network 2 the model's rooms replace both. A rectangle gives up the pixels of the grown rooms kept for
+// The project's own prediction method, "default": per closed door, one of three candidate rooms, a rectangle
+// fitted to the walls the robot saw around the door, the room grown on the layout's cell grid by the thesis's
+// method (thesis_predictor.h, with its default parameters) and the room the learned room model sees behind the
+// door (room_network.h): the one that agrees most (IoU) with the other two (mostAgreedCandidate; default_network
+// 3). Other choices: default_network 1 keeps the rectangle or the grown room, whichever agrees more with the
+// model's room; 2 the model's rooms; 0 (and every choice on maps too fine for the model: networkReads) the grown
+// room when it is at least default_grown_area_ratio times the rectangle (the rectangle stopped short, e.g. of an
+// L-shaped room). A missing candidate is never chosen. A rectangle gives up the pixels of the grown rooms kept for
 // the other doors. The growth runs on a second thread while the rectangles are fitted (predict() is still safe to
 // call from several threads).
 //
@@ -47,13 +48,14 @@
 // Parameters: start_search_radius and the default_* keys (config/prediction.yaml), and the layout's
 // (config/layout.yaml) for the grown rooms; --debug-dir receives the layout's images (of the map turned
 // straight, on a turned map).
-// terms: "rectangle" (1 when the rectangle was chosen, 0 the grown room or, with default_network 2, the learned
-// model's room, which has no terms of its own); a grown room has the thesis's terms, a
+// terms: "rectangle" (1 when the rectangle was chosen), "model_room" (1 when the learned model's room was chosen;
+// it has no terms of its own); a grown room has the thesis's terms, a
 // rectangle "width", "depth" (metres), "depth_bounded" (1 when the depth came from the map, 0 from a prior);
 // every room "rotation" (the wall angle its door was predicted at, degrees; the map was turned when it is at least
 // default_min_rotation), "outline_clipped" (m^2 removed by the outline clip) and, with a margin, "wall_margin"
 // (metres) and "wall_margin_cut" (m^2 removed by it).
 
+#include <array>
 #include <map>
 #include <string>
 
@@ -78,8 +80,21 @@ struct DefaultOptions {
   double stub_length = 0.3;          // m: wall stubs this long into the explored side end a room's extent
   double outline_reach = 15.0;       // m: band beside a room within which the known map's extent bounds it
   double wall_margin = -1.0;         // m: unseen wall thickness left out of rooms; < 0: estimated from the map
-  int network = 1;                   // the learned room model: 0 unused; 1 chooses rectangle or grown room; 2 its rooms
+  int network = 3;  // the learned room model: 0 unused; 1 chooses rectangle or grown room; 2 its rooms; 3 the
+                    // candidate room agreeing most with the other two
 };
+
+// A door's candidate rooms under default_network 3, and their pairwise IoUs (0 where one is missing).
+enum class RoomCandidate { kRectangle = 0, kGrown = 1, kModel = 2 };
+struct CandidateAgreement {
+  double rectangle_grown = 0.0;
+  double rectangle_model = 0.0;
+  double grown_model = 0.0;
+};
+
+// The candidate that agrees most with the other two: the highest sum of its IoUs with them, among those present
+// (indexed by RoomCandidate); ties go to the grown room, then the rectangle. kGrown when none is present.
+RoomCandidate mostAgreedCandidate(const CandidateAgreement& iou, const std::array<bool, 3>& present);
 
 // Every DefaultOptions field as a parameter (start_search_radius, default_wall_gap, ...) with its range.
 const common::OptionTable<DefaultOptions>& defaultOptionTable();
