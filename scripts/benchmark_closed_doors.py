@@ -3,12 +3,15 @@
 
 Usage: benchmark_closed_doors.py BENCH_DIR --method NAME [--methods A,B,...] [--part P] [--jobs N]
                                  [--binary PATH] [--keep DIR] [--params FILE.yaml] [--csv FILE] [--plot FILE.png]
+                                 [--agreement]
 
 For every valid case of BENCH_DIR/cases.csv it runs `predict_rooms_offline` once per method (in parallel),
 times the whole command, reads the per-door IoU from the command's metrics.yaml and computes the thesis
 implementation's IoU from reference_rooms.png vs gt_rooms.png where a case has one. It prints a table by number
 of closed doors, one per environment, the overall mean IoU per method and of the reference, and the time and
-peak memory per method. Any folder in the benchmark's layout works, e.g. the cases of make_closed_door_corpus
+peak memory per method. With --agreement it also compares each method's rooms with the thesis implementation's,
+room by room (the IoU of the method's room k with reference_rooms.png's room k; 1 when both are empty), per case
+and by number of closed doors, next to the IoU against the truth. Any folder in the benchmark's layout works, e.g. the cases of make_closed_door_corpus
 (whose cases.csv has a `part` column: --part validation).
 
 Peak memory is the maximum resident set size of each command as measured by `/usr/bin/time -f %M` (GNU time),
@@ -140,15 +143,15 @@ def read_label_image(path):
     return image
 
 
-def door_ious(predicted, truth, doors):
-    """IoU of label k in both images for k = 1..doors (0 when both are empty)."""
+def door_ious(predicted, truth, doors, both_empty=0.0):
+    """IoU of label k in both images for k = 1..doors (`both_empty` when both are empty)."""
     ious = []
     for label in range(1, doors + 1):
         predicted_room = predicted == label
         true_room = truth == label
         union = np.count_nonzero(predicted_room | true_room)
         intersection = np.count_nonzero(predicted_room & true_room)
-        ious.append(intersection / union if union else 0.0)
+        ious.append(intersection / union if union else both_empty)
     return ious
 
 
@@ -203,6 +206,7 @@ class Run:
         self.mean_iou = 0.0
         self.iou_total = 0.0
         self.door_ious = []
+        self.agreement = None  # with --agreement and a reference: per door, IoU with reference_rooms.png's room
         self.seconds = None
         self.max_rss_kb = None
         self.problem = None  # None when the run succeeded
@@ -255,8 +259,9 @@ def read_max_rss(path):
         return None
 
 
-def run_case(binary, case, method, out_root, params, timeout):
-    """Runs the offline command for one case and method and reads its metrics."""
+def run_case(binary, case, method, out_root, params, timeout, agreement=False):
+    """Runs the offline command for one case and method and reads its metrics (and, with `agreement`, compares
+    its rooms with the case's reference_rooms.png)."""
     run = Run(case, method)
     out_dir = os.path.join(out_root, method, case.env, case.name)
     log_dir = out_dir + ".log"
@@ -287,15 +292,26 @@ def run_case(binary, case, method, out_root, params, timeout):
     except (OSError, yaml.YAMLError, TypeError, KeyError, ValueError) as error:
         run.mean_iou = run.iou_total = 0.0
         run.problem = "cannot read %s: %s" % (metrics_path, error)
+        return run
+    if agreement and case.reference_iou is not None:
+        try:
+            rooms = read_label_image(os.path.join(out_dir, "rooms.png"))
+            reference = read_label_image(case.path("reference_rooms.png"))
+            if rooms.shape != reference.shape:
+                raise ValueError("rooms.png is %dx%d, reference_rooms.png %dx%d" % (
+                    rooms.shape[1], rooms.shape[0], reference.shape[1], reference.shape[0]))
+            run.agreement = door_ious(rooms, reference, case.doors, both_empty=1.0)
+        except ValueError as error:
+            run.problem = "cannot compare with the reference: %s" % error
     return run
 
 
-def run_all(binary, cases, methods, out_root, params, jobs, timeout):
+def run_all(binary, cases, methods, out_root, params, jobs, timeout, agreement=False):
     """Runs every method on every case in parallel, with a progress bar; returns {method: [Run]} in case order."""
     tasks = [(case, method) for method in methods for case in cases]
     results = {}
     with concurrent.futures.ThreadPoolExecutor(max_workers=jobs) as pool:
-        futures = {pool.submit(run_case, binary, case, method, out_root, params, timeout): (case, method)
+        futures = {pool.submit(run_case, binary, case, method, out_root, params, timeout, agreement): (case, method)
                    for case, method in tasks}
         with tqdm(total=len(futures), unit="run", desc="cases", file=sys.stderr) as progress:
             for future in concurrent.futures.as_completed(futures):
@@ -389,6 +405,52 @@ def print_overall(cases, methods, runs):
     print()
 
 
+def print_agreement(cases, methods, runs):
+    """Room-by-room agreement with reference_rooms.png (--agreement): per case, by number of closed doors and
+    overall, each method's mean over the rooms next to its mean IoU against the truth over the same cases."""
+    indices = [i for i, case in enumerate(cases) if case.reference_iou is not None]
+    print("Agreement with the thesis's implementation: room-by-room IoU with reference_rooms.png (1 when both are")
+    print("empty), next to the mean IoU against the truth; %d cases with a reference" % len(indices))
+    if not indices:
+        print()
+        return
+    width = max(len("ref IoU"), *(len(method) + 4 for method in methods)) + 2
+    label_width = max(len(cases[i].label) for i in indices)
+    header = "".join(("%s agr" % method).rjust(width) + ("%s IoU" % method).rjust(width) for method in methods)
+    print("%s  doors%s%s" % ("case".ljust(label_width), header, "ref IoU".rjust(width)))
+    for i in indices:
+        columns = []
+        for method in methods:
+            run = runs[method][i]
+            columns.append(format_score(None if run.agreement is None else np.mean(run.agreement), width))
+            columns.append(format_score(None if run.failed else run.mean_iou, width))
+        print("%s  %5d%s%s" % (cases[i].label.ljust(label_width), cases[i].doors, "".join(columns),
+                               format_score(cases[i].reference_iou, width)))
+    print()
+
+    def rooms_of(method, selected):
+        return [value for i in selected if runs[method][i].agreement is not None for value in runs[method][i].agreement]
+
+    print("By number of closed doors (agreement: mean over the rooms)")
+    print("doors  rooms%s%s" % (header, "ref IoU".rjust(width)))
+    for doors in sorted({cases[i].doors for i in indices}):
+        selected = [i for i in indices if cases[i].doors == doors]
+        columns = []
+        for method in methods:
+            columns.append(format_score(mean_or_none(rooms_of(method, selected)), width))
+            columns.append(format_score(mean_or_none(runs[method][i].mean_iou for i in selected), width))
+        print("%5d  %5d%s%s" % (doors, doors * len(selected), "".join(columns),
+                               format_score(mean_or_none(cases[i].reference_iou for i in selected), width)))
+    for method in methods:
+        rooms = rooms_of(method, indices)
+        if rooms:
+            print("  %s: agreement mean %.4f, median %.4f over %d rooms; mean IoU %.4f against the reference's %.4f"
+                  % (method, np.mean(rooms), np.median(rooms), len(rooms),
+                     np.mean([runs[method][i].mean_iou for i in indices]),
+                     np.mean([cases[i].reference_iou for i in indices])))
+    print()
+
+
 def print_resources(methods, runs):
     """Median and p95 wall seconds per case, and peak memory, per method."""
     print("Time per case (wall time of the whole command, successful runs) and peak memory (max RSS, /usr/bin/time)")
@@ -479,6 +541,8 @@ def parse_arguments(argv):
     parser.add_argument("--params", metavar="FILE.yaml", help="parameter overrides passed to every run")
     parser.add_argument("--csv", metavar="FILE", help="write the per-case rows to FILE")
     parser.add_argument("--plot", metavar="FILE.png", help="plot mean IoU vs closed doors to FILE.png")
+    parser.add_argument("--agreement", action="store_true",
+                        help="compare each method's rooms with reference_rooms.png, room by room")
     parser.add_argument("--timeout", type=float, default=600.0,
                         help="seconds before a run is killed and counted as failed (default 600, 0 = none)")
     args = parser.parse_args(argv)
@@ -524,7 +588,7 @@ def main(argv=None):
         out_root = tempfile.mkdtemp(prefix="benchmark_closed_doors_")
     params = os.path.abspath(args.params) if args.params else None
     try:
-        runs = run_all(binary, cases, args.method_list, out_root, params, args.jobs, args.timeout)
+        runs = run_all(binary, cases, args.method_list, out_root, params, args.jobs, args.timeout, args.agreement)
     finally:
         if not args.keep:
             shutil.rmtree(out_root, ignore_errors=True)
@@ -533,6 +597,8 @@ def main(argv=None):
     print_table(cases, args.method_list, runs)
     print_environments(cases, args.method_list, runs)
     print_overall(cases, args.method_list, runs)
+    if args.agreement:
+        print_agreement(cases, args.method_list, runs)
     print_resources(args.method_list, runs)
     failures = print_failures(args.method_list, runs)
     if args.csv:

@@ -71,6 +71,9 @@ class DoorIou(unittest.TestCase):
         self.assertAlmostEqual(ious[0], 0.5)  # 2 of 4 pixels, nothing extra
         self.assertEqual(ious[1], 0.0)  # no prediction
         self.assertEqual(ious[2], 0.0)  # predicted but no true room
+        # --agreement counts two empty rooms as agreeing.
+        self.assertEqual(module.door_ious(predicted, truth, 4, both_empty=1.0)[3], 1.0)
+        self.assertEqual(module.door_ious(predicted, truth, 4, both_empty=1.0)[1], 0.0)
 
 
 class BadBenchmarkFolder(unittest.TestCase):
@@ -159,6 +162,31 @@ class SmallBenchmark(unittest.TestCase):
         self.assertIsNotNone(overall, result.stdout)
         self.assertEqual(int(overall.group(2)), len(SELECTED_CASES))
         self.assertAlmostEqual(float(overall.group(1)), np.mean(list(expected.values())), delta=0.01)
+
+    def test_agreement_with_the_truth_as_reference(self):
+        """With reference_rooms.png replaced by gt_rooms.png, a method's room-by-room agreement with the reference
+        is its IoU against the truth, case by case."""
+        folder = tempfile.mkdtemp(prefix="bench_agreement_")
+        try:
+            for row in self.rows:
+                case_dir = os.path.join(folder, row["env"], row["case"])
+                shutil.copytree(os.path.join(self.folder, row["env"], row["case"]), case_dir)
+                shutil.copyfile(os.path.join(case_dir, "gt_rooms.png"), os.path.join(case_dir, "reference_rooms.png"))
+            self.write_cases(folder, self.rows)
+            result = run_script(folder, "--method", self.method, "--binary", self.binary, "--agreement")
+        finally:
+            shutil.rmtree(folder, ignore_errors=True)
+        self.assertEqual(result.returncode, 0, result.stdout + result.stderr)
+        lines = {}
+        for line in result.stdout.splitlines():
+            fields = line.split()
+            if len(fields) == 5 and "/" in fields[0] and fields[1].isdigit():
+                lines[fields[0]] = [float(value) for value in fields[2:]]
+        self.assertEqual(sorted(lines), sorted("%s/%s" % (row["env"], row["case"]) for row in self.rows))
+        for label, (agreement, iou, reference_iou) in lines.items():
+            self.assertAlmostEqual(agreement, iou, delta=1e-3, msg=label)
+            self.assertAlmostEqual(reference_iou, 1.0, msg=label)
+        self.assertRegex(result.stdout, r"%s: agreement mean [0-9.]+, median [0-9.]+ over 5 rooms" % self.method)
 
     def test_failed_case_is_reported_and_others_continue(self):
         folder = tempfile.mkdtemp(prefix="bench_broken_")
