@@ -32,9 +32,18 @@ const common::OptionTable<LayoutOptions>& layoutOptionTable() {
       {"hough_max_line_gap", &O::hough_max_line_gap,
        "m: largest gap bridged inside a segment (3 px)", common::atLeast(0)},
       {"angular_bandwidth", &O::angular_bandwidth,
-       "rad: mean-shift bandwidth of the angular clustering", {0, CV_PI / 2, true, true}},
+       "mean-shift bandwidth of the angular clustering: 1 - cos of the angle (kernel 1) or rad (kernel 0)",
+       {0, CV_PI / 2, true, true}},
+      {"angular_kernel", &O::angular_kernel,
+       "1: the reference code's biweight kernel on 1 - cos, unweighted; 0: a flat window in rad, by length",
+       {0, 1, false, false, true}},
       {"wall_cluster_distance", &O::wall_cluster_distance,
-       "m: largest lateral spread of one wall's segments (10 px)", common::atLeast(0)},
+       "m: lateral reach of one wall's segments (10 px)", common::atLeast(0)},
+      {"wall_chaining", &O::wall_chaining,
+       "1: a wall chains segments less than wall_cluster_distance apart (the reference code's); 0: bounded spread"},
+      {"diagonal_limit", &O::diagonal_limit,
+       "rad: angular clusters farther from both axes are dropped; 0: every wall kept, turned to the nearer axis",
+       common::between(0, CV_PI / 4)},
       {"line_merge_distance", &O::line_merge_distance,
        "m: extended lines this close become one (no sliver cells)", common::atLeast(0)},
       {"door_pair_lines", &O::door_pair_lines, "add Algorithm 1's lines between pairs of closed doors"},
@@ -177,16 +186,80 @@ double angleDifference(double a, double b) {
 }
 
 // ---------------------------------------------------------------------------------------------------------
-// Angular clustering: 1-D mean shift with a flat kernel on the segments' angles modulo pi, each segment
-// weighted by its length. Every segment's angle seeds a search; modes closer than the bandwidth merge; each
-// segment joins its nearest mode, which finally becomes the weighted mean angle of its members.
+// Angular clustering: 1-D mean shift on the segments' angles modulo pi, by one of two kernels.
 
-void clusterAngles(double bandwidth, Layout* layout) {
+// The reference code's kernel: every segment's angle seeds a mean shift whose kernel weighs an angle at
+// difference d from the centre by (1 - c)^2 with c = (1 - cos d) / bandwidth (0 beyond c = 1), segments
+// unweighted by length, all centres shifted until none moves more than 1e-5 rad; each segment belongs to the
+// centre its own seed reached, and centres within 0.01 rad of each other are one cluster (their mean).
+// `layout` has at least one segment and no clusters yet (clusterAngles).
+void clusterAnglesByCosineKernel(double bandwidth, Layout* layout) {
   const std::vector<ImageSegment>& segments = layout->segments;
   const int n = static_cast<int>(segments.size());
-  layout->angular_modes.clear();
-  layout->segment_angular_cluster.assign(n, -1);
-  if (n == 0) return;
+  constexpr double kConverged = 1e-5, kSameCentre = 0.01;
+  const double reach = std::acos(std::max(-1.0, 1.0 - bandwidth));  // the kernel's support, rad
+  std::vector<double> sorted;
+  for (const ImageSegment& segment : segments) sorted.push_back(segment.angle());
+  std::sort(sorted.begin(), sorted.end());
+  std::vector<double> angles;  // repeated at -pi and +pi so that a window never wraps
+  for (double shift : {-CV_PI, 0.0, CV_PI})
+    for (double angle : sorted) angles.push_back(angle + shift);
+  const auto shifted = [&](double centre) {
+    const size_t lo = std::lower_bound(angles.begin(), angles.end(), centre - reach) - angles.begin();
+    const size_t hi = std::upper_bound(angles.begin(), angles.end(), centre + reach) - angles.begin();
+    double weight_sum = 0.0, moment = 0.0;
+    for (size_t k = lo; k < hi; ++k) {
+      const double c = (1.0 - std::cos(angles[k] - centre)) / bandwidth;
+      if (c > 1.0) continue;
+      const double weight = (1.0 - c) * (1.0 - c);
+      weight_sum += weight;
+      moment += weight * (angles[k] - centre);
+    }
+    return weight_sum > 0 ? common::angleModuloPi(centre + moment / weight_sum) : centre;
+  };
+  std::vector<double> centres(n);
+  for (int s = 0; s < n; ++s) centres[s] = segments[s].angle();
+  for (int iteration = 0; iteration < 1000; ++iteration) {
+    double largest = 0.0;
+    for (double& centre : centres) {
+      const double next = shifted(centre);
+      largest = std::max(largest, std::abs(angleDifference(next, centre)));
+      centre = next;
+    }
+    if (largest <= kConverged) break;
+  }
+  // Centres within 0.01 rad (chained, around the circle) are one cluster at their mean.
+  std::vector<int> order(n);
+  for (int s = 0; s < n; ++s) order[s] = s;
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return centres[a] < centres[b]; });
+  std::vector<int> group(n, 0);
+  for (int k = 1; k < n; ++k)
+    group[order[k]] = group[order[k - 1]] +
+                      (std::abs(angleDifference(centres[order[k]], centres[order[k - 1]])) <= kSameCentre ? 0 : 1);
+  int groups = group[order[n - 1]] + 1;
+  if (groups > 1 && std::abs(angleDifference(centres[order[0]], centres[order[n - 1]])) <= kSameCentre) {
+    for (int& g : group)
+      if (g == groups - 1) g = 0;
+    --groups;
+  }
+  std::vector<double> offset_sum(groups, 0.0), reference(groups, 0.0);
+  std::vector<int> members(groups, 0);
+  for (int s = 0; s < n; ++s) {
+    if (members[group[s]] == 0) reference[group[s]] = centres[s];
+    offset_sum[group[s]] += angleDifference(centres[s], reference[group[s]]);
+    ++members[group[s]];
+  }
+  for (int g = 0; g < groups; ++g)
+    layout->angular_modes.push_back(common::angleModuloPi(reference[g] + offset_sum[g] / members[g]));
+  layout->segment_angular_cluster = group;
+}
+
+// A flat kernel of +-bandwidth rad, each segment weighted by its length. Every segment's angle seeds a search;
+// modes closer than the bandwidth merge; each segment joins its nearest mode, which finally becomes the weighted
+// mean angle of its members. `layout` has at least one segment and no clusters yet (clusterAngles).
+void clusterAnglesByFlatWindow(double bandwidth, Layout* layout) {
+  const std::vector<ImageSegment>& segments = layout->segments;
+  const int n = static_cast<int>(segments.size());
 
   // Angles sorted, repeated at -pi and +pi so that a window never needs wrapping; prefix sums of weights and
   // weighted angles give every window's mean in O(log n).
@@ -264,16 +337,33 @@ void clusterAngles(double bandwidth, Layout* layout) {
   for (int& cluster : layout->segment_angular_cluster) cluster = renumber[cluster];
 }
 
+// Sets the segments' angular clusters and the clusters' angles by the kernel `options` names.
+void clusterAngles(const LayoutOptions& options, Layout* layout) {
+  layout->angular_modes.clear();
+  layout->segment_angular_cluster.assign(layout->segments.size(), -1);
+  if (layout->segments.empty()) return;
+  if (options.angular_kernel == 1)
+    clusterAnglesByCosineKernel(options.angular_bandwidth, layout);
+  else
+    clusterAnglesByFlatWindow(options.angular_bandwidth, layout);
+}
+
 // ---------------------------------------------------------------------------------------------------------
 // Spatial clustering inside each angular cluster: segments sorted by their lateral offset (distance of their
-// midpoint from a line through the origin along the cluster's angle); a wall takes segments while their offset
-// stays within `max_spread` pixels of the wall's first (smallest) offset, so that one wall never spans more
-// than `max_spread` across (a chain of close segments cannot grow into a thick band).
+// midpoint from a line through the origin along the cluster's angle). `chained` (the reference code's): a wall
+// takes segments while each offset is less than `max_spread` pixels from the previous one, and lies at the
+// median offset (the upper one of an even count). Otherwise a wall takes segments while their offset stays
+// within `max_spread` of the wall's first (smallest) offset, so that it never spans more than `max_spread` across,
+// and lies at the members' length-weighted mean offset. Angular clusters farther than `diagonal_limit` rad from
+// both axes give no walls (0: every cluster gives walls).
 
-void clusterWalls(double max_spread, Layout* layout) {
+void clusterWalls(double max_spread, bool chained, double diagonal_limit, Layout* layout) {
   layout->walls.clear();
   for (int cluster = 0; cluster < static_cast<int>(layout->angular_modes.size()); ++cluster) {
     const double mode = layout->angular_modes[cluster];
+    const double from_axis =
+        std::min(std::abs(angleDifference(mode, 0.0)), std::abs(angleDifference(mode, CV_PI / 2)));
+    if (diagonal_limit > 0 && from_axis > diagonal_limit) continue;
     const common::Point2 along(std::cos(mode), std::sin(mode));
     const common::Point2 across(-along.y(), along.x());
     std::vector<std::pair<double, int>> offsets;  // (offset, segment)
@@ -285,7 +375,11 @@ void clusterWalls(double max_spread, Layout* layout) {
     std::sort(offsets.begin(), offsets.end());
     for (size_t first = 0; first < offsets.size();) {
       size_t end = first;
-      while (end < offsets.size() && offsets[end].first - offsets[first].first <= max_spread) ++end;
+      if (chained)  // single linkage: each segment within max_spread of the previous one
+        while (end < offsets.size() && (end == first || offsets[end].first - offsets[end - 1].first < max_spread))
+          ++end;
+      else
+        while (end < offsets.size() && offsets[end].first - offsets[first].first <= max_spread) ++end;
       Wall wall;
       wall.angular_cluster = cluster;
       double weighted_offset = 0, total_length = 0;
@@ -300,7 +394,7 @@ void clusterWalls(double max_spread, Layout* layout) {
           t_max = std::max(t_max, along.dot(p));
         }
       }
-      const double offset = weighted_offset / total_length;
+      const double offset = chained ? offsets[first + (end - first) / 2].first : weighted_offset / total_length;
       wall.segment.a = offset * across + t_min * along;
       wall.segment.b = offset * across + t_max * along;
       layout->walls.push_back(std::move(wall));
@@ -655,8 +749,9 @@ Layout analyzeLayout(const common::OccupancyGrid& map, const std::vector<common:
     layout.segments.push_back(segment);
   }
 
-  clusterAngles(options.angular_bandwidth, &layout);
-  clusterWalls(toPixelDistance(options.wall_cluster_distance, resolution), &layout);
+  clusterAngles(options, &layout);
+  clusterWalls(toPixelDistance(options.wall_cluster_distance, resolution), options.wall_chaining,
+               options.diagonal_limit, &layout);
 
   // Bounding box of the segments (the whole image when there are none) and the boundary lines around it.
   if (layout.segments.empty()) {

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <sstream>
 
@@ -250,6 +251,77 @@ TEST(Layout, MapsWithoutWallsGiveOneBorderCellAndNoStart) {
       EXPECT_FALSE(layout.doors[0].found);
       EXPECT_FALSE(layout.doors[0].problem.empty());
     }
+}
+
+// A free map of 200 x 200 pixels of 0.05 m with the given wall pixels.
+common::OccupancyGrid freeMapWithWalls(const std::function<void(cv::Mat1b*)>& draw) {
+  cv::Mat1b walls = cv::Mat1b::zeros(200, 200);
+  draw(&walls);
+  common::OccupancyGrid map;
+  map.resolution = 0.05;
+  map.cells = cv::Mat_<int8_t>(walls.size(), common::OccupancyGrid::kFree);
+  map.cells.setTo(common::OccupancyGrid::kOccupied, walls);
+  return map;
+}
+
+int verticalWallLinesBetween(const Layout& layout, int x0, int x1) {
+  return static_cast<int>(std::count_if(layout.lines.begin(), layout.lines.end(), [&](const ExtendedLine& line) {
+    return line.source == LineSource::kWall && line.axis == LineAxis::kVertical && line.position >= x0 &&
+           line.position <= x1;
+  }));
+}
+
+// Angular clustering: a horizontal wall and one turned by 2 degrees (0.035 rad) are one angular cluster under the
+// reference code's kernel (its bandwidth 0.023 is 1 - cos of the angle: it reaches 12.3 degrees) and two under a
+// flat window of 0.023 rad.
+TEST(Layout, TheReferenceKernelMeasuresItsBandwidthAsOneMinusCosine) {
+  const common::OccupancyGrid map = freeMapWithWalls([](cv::Mat1b* walls) {
+    cv::line(*walls, cv::Point(20, 50), cv::Point(180, 50), 255, 3);
+    const double slope = std::tan(2.0 * CV_PI / 180.0);
+    cv::line(*walls, cv::Point(20, 140), cv::Point(180, static_cast<int>(std::lround(140 + 160 * slope))), 255, 3);
+  });
+  LayoutOptions options;
+  options.angular_kernel = 0;
+  EXPECT_EQ(analyzeLayout(map, {}, options).angular_modes.size(), 2u);
+  options.angular_kernel = 1;
+  const Layout layout = analyzeLayout(map, {}, options);
+  ASSERT_EQ(layout.angular_modes.size(), 1u);
+  EXPECT_LT(std::abs(std::remainder(layout.angular_modes[0], CV_PI)), 2.0 * CV_PI / 180.0);
+}
+
+// Wall clustering: faces at x = 100, 106 (a 6 px wall) and 112, 114 (a 2 px wall beside it). Chained (the reference
+// code's), each face is less than 10 px (0.5 m) from the previous one: one wall, at one of the two middle faces
+// (106 or 112). With a bounded spread, the faces within 10 px of the first make a wall (100, 106) and the rest
+// another: two lines, farther apart than line_merge_distance.
+TEST(Layout, ChainedWallsJoinFacesThatFollowEachOtherClosely) {
+  const common::OccupancyGrid map = freeMapWithWalls([](cv::Mat1b* walls) {
+    (*walls)(cv::Rect(100, 30, 6, 140)).setTo(255);
+    (*walls)(cv::Rect(112, 30, 2, 140)).setTo(255);
+  });
+  LayoutOptions options;
+  options.wall_chaining = false;
+  EXPECT_EQ(verticalWallLinesBetween(analyzeLayout(map, {}, options), 95, 120), 2);
+  options.wall_chaining = true;
+  const Layout chained = analyzeLayout(map, {}, options);
+  ASSERT_EQ(verticalWallLinesBetween(chained, 95, 120), 1);
+  EXPECT_EQ(verticalWallLinesBetween(chained, 105, 112), 1);
+}
+
+// A wall at 45 degrees gives no line with diagonal_limit 0.15 rad (the reference code deletes its segments) and
+// one along an axis without it.
+TEST(Layout, DiagonalWallsAreDroppedBeyondTheLimit) {
+  const common::OccupancyGrid map = freeMapWithWalls([](cv::Mat1b* walls) {
+    cv::line(*walls, cv::Point(40, 40), cv::Point(160, 160), 255, 3);
+  });
+  const auto wall_lines = [&](double limit) {
+    LayoutOptions options;
+    options.diagonal_limit = limit;
+    const Layout layout = analyzeLayout(map, {}, options);
+    return std::count_if(layout.lines.begin(), layout.lines.end(),
+                         [](const ExtendedLine& line) { return line.source == LineSource::kWall; });
+  };
+  EXPECT_GT(wall_lines(0.0), 0);
+  EXPECT_EQ(wall_lines(0.15), 0);
 }
 
 TEST(Layout, ParametersByNameValidateAndRejectUnknownNames) {

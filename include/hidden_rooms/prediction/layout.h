@@ -35,8 +35,11 @@ struct LayoutOptions {
   double hough_threshold = 1.0;            // m: accumulator votes, as edge length (20 votes at 0.05 m)
   double hough_min_line_length = 0.35;     // m: shortest segment kept (7 px at 0.05 m)
   double hough_max_line_gap = 0.15;        // m: largest gap bridged inside a segment (3 px)
-  double angular_bandwidth = 0.023;        // rad: mean-shift bandwidth of the angular clustering
-  double wall_cluster_distance = 0.5;      // m: largest lateral spread of one wall's segments (10 px)
+  double angular_bandwidth = 0.023;        // mean-shift bandwidth: 1 - cos of the angle (kernel 1), rad (kernel 0)
+  int angular_kernel = 0;                  // 1: the reference code's biweight on 1 - cos; 0: flat window in rad
+  double wall_cluster_distance = 0.5;      // m: lateral reach of one wall's segments (10 px)
+  bool wall_chaining = false;              // true: segments chain into a wall (the reference code's); false: bounded
+  double diagonal_limit = 0.0;             // rad: angular clusters farther from both axes are dropped; 0: none
   double line_merge_distance = 0.25;       // m: extended lines this close become one (no sliver cells)
   bool door_pair_lines = true;             // add Algorithm 1's lines between pairs of closed doors
   double boundary_offset = 1.0;            // m: boundary lines outside the segments' bounding box (20 px)
