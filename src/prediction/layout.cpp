@@ -58,6 +58,8 @@ const common::OptionTable<LayoutOptions>& layoutOptionTable() {
       {"dbscan_eps", &O::dbscan_eps, "DBSCAN radius on the distance 1 - affinity, in (0, 1)", {0, 1, true, true}},
       {"dbscan_min_points", &O::dbscan_min_points,
        "DBSCAN core-point size (the cell itself counts)", common::atLeast(1)},
+      {"door_start_fallback", &O::door_start_fallback,
+       "1: a door without an IN/OUT edge starts at the more unknown cell of its nearest parallel edge"},
       {"door_search_radius", &O::door_search_radius,
        "m: a door's IN/OUT cell edge must be this close", common::above(0)},
   };
@@ -644,7 +646,8 @@ int segmentRooms(const LayoutOptions& options, CellGrid* grid) {
 // --------------------------------------------------------------------------------------------------------- Doors
 // (docs/method.md#door-start-cells): the nearest grid edge between an IN and an OUT cell, preferring edges parallel
 // to the door line (an O door lies on a horizontal edge, a V door on a vertical one) and falling back to the other
-// orientation when no parallel edge is within the search radius.
+// orientation when no parallel edge is within the search radius; with door_start_fallback, then the nearest
+// parallel edge between any two cells, its more unknown cell (which may be IN) as the start cell.
 
 double distanceToImageSegment(const common::Point2& p, const ImageSegment& s) {
   return common::distanceToSegment(p, s.a, s.b);
@@ -657,17 +660,21 @@ std::vector<DoorStart> placeDoors(const common::OccupancyGrid& map, const std::v
     ImageSegment edge;
     bool horizontal;
   };
-  std::vector<Candidate> candidates;
+  // The IN/OUT edges, and the others with their more unknown cell in out_cell (for door_start_fallback).
+  std::vector<Candidate> candidates, other_edges;
   for (int cell = 0; cell < grid.size(); ++cell)
     for (int other : {grid.column(cell) + 1 < grid.columns() ? cell + 1 : -1,
                       grid.row(cell) + 1 < grid.rows() ? cell + grid.columns() : -1}) {
-      if (other < 0 || grid.cells[cell].out == grid.cells[other].out) continue;
+      if (other < 0) continue;
+      const bool in_out = grid.cells[cell].out != grid.cells[other].out;
+      const bool cell_first = in_out ? grid.cells[cell].out
+                                     : grid.cells[cell].unknown_fraction >= grid.cells[other].unknown_fraction;
       Candidate candidate;
-      candidate.out_cell = grid.cells[cell].out ? cell : other;
-      candidate.in_cell = grid.cells[cell].out ? other : cell;
+      candidate.out_cell = cell_first ? cell : other;
+      candidate.in_cell = cell_first ? other : cell;
       grid.sharedEdge(cell, other, &candidate.edge);
       candidate.horizontal = other != cell + 1;
-      candidates.push_back(candidate);
+      (in_out ? candidates : other_edges).push_back(candidate);
     }
 
   const double radius_pixels = toPixelDistance(options.door_search_radius, map.resolution);
@@ -686,8 +693,8 @@ std::vector<DoorStart> placeDoors(const common::OccupancyGrid& map, const std::v
     const bool door_horizontal = door.orientation == common::DoorOrientation::kAlongX;
     const Candidate* best = nullptr;
     double best_distance = std::numeric_limits<double>::infinity();
-    for (bool parallel_only : {true, false}) {
-      for (const Candidate& candidate : candidates) {
+    const auto find_nearest = [&](const std::vector<Candidate>& edges, bool parallel_only) {
+      for (const Candidate& candidate : edges) {
         if (parallel_only && candidate.horizontal != door_horizontal) continue;
         const double distance = distanceToImageSegment(p, candidate.edge);
         if (distance <= radius_pixels && distance < best_distance) {
@@ -695,8 +702,10 @@ std::vector<DoorStart> placeDoors(const common::OccupancyGrid& map, const std::v
           best = &candidate;
         }
       }
-      if (best != nullptr) break;
-    }
+    };
+    find_nearest(candidates, true);
+    if (best == nullptr) find_nearest(candidates, false);
+    if (best == nullptr && options.door_start_fallback) find_nearest(other_edges, true);
     if (best == nullptr) {
       start.problem = "no cell edge between explored and unknown space within " +
                       common::formatNumber(options.door_search_radius) + " m of the door";

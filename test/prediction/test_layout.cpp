@@ -16,6 +16,7 @@
 #include "hidden_rooms/common/input_error.h"
 #include "hidden_rooms/prediction/layout.h"
 #include "hidden_rooms/prediction/structured_predictor.h"
+#include "hidden_rooms/prediction/thesis_predictor.h"
 #include "test_util.h"
 
 namespace hidden_rooms::prediction {
@@ -322,6 +323,39 @@ TEST(Layout, DiagonalWallsAreDroppedBeyondTheLimit) {
   };
   EXPECT_GT(wall_lines(0.0), 0);
   EXPECT_EQ(wall_lines(0.15), 0);
+}
+
+// A door whose hidden room shows only as a small unknown pocket in a cell that is mostly free (IN): no IN/OUT edge
+// is near it, so it is not placed; with door_start_fallback it starts at the pocket's cell, across the edge it lies
+// on from the corridor.
+TEST(Layout, ADoorBesideNoOutCellStartsAtTheMoreUnknownCellWithTheFallback) {
+  SyntheticFloor floor = makeFloor(1);
+  floor.map.cells(cv::Rect(144, 20, 136, 96)).setTo(common::OccupancyGrid::kFree);      // room B seen ...
+  floor.map.cells(cv::Rect(190, 100, 50, 16)).setTo(common::OccupancyGrid::kUnknown);  // ... but a pocket
+  LayoutOptions options;
+  const Layout without = analyzeLayout(floor.map, floor.doors.doors, options);
+  ASSERT_EQ(without.doors.size(), 1u);
+  EXPECT_FALSE(without.doors[0].found);
+  const int room_b = without.grid.cellAt(floor.image(212, 68));
+  ASSERT_GE(room_b, 0);
+  EXPECT_FALSE(without.grid.cells[room_b].out);
+  options.door_start_fallback = true;
+  const Layout with = analyzeLayout(floor.map, floor.doors.doors, options);
+  ASSERT_TRUE(with.doors[0].found) << with.doors[0].problem;
+  EXPECT_EQ(with.doors[0].start_cell, with.grid.cellAt(floor.image(212, 68)));
+  EXPECT_EQ(with.doors[0].explored_cell, with.grid.cellAt(floor.image(212, 140)));
+  // The thesis method then grows the room from that cell: all of the pocket, and no known pixel.
+  PredictionRequest request;
+  request.map = floor.map;
+  request.doors = floor.doors;
+  request.parameters["door_start_fallback"] = 1;
+  const PredictionResult result = ThesisPredictor().predict(request);
+  ASSERT_EQ(result.rooms.size(), 1u);
+  ASSERT_TRUE(result.rooms[0].placed) << result.rooms[0].problem;
+  cv::Mat1b pocket = cv::Mat1b::zeros(floor.map.cells.size());
+  pocket(cv::Rect(190, 100, 50, 16)).setTo(255);
+  EXPECT_EQ(cv::countNonZero(pocket & ~result.rooms[0].mask), 0);
+  EXPECT_EQ(cv::countNonZero(result.rooms[0].mask & (floor.map.cells != common::OccupancyGrid::kUnknown)), 0);
 }
 
 TEST(Layout, ParametersByNameValidateAndRejectUnknownNames) {
