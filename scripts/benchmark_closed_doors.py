@@ -11,8 +11,8 @@ implementation's IoU from reference_rooms.png vs gt_rooms.png where a case has o
 of closed doors, one per environment, the overall mean IoU per method and of the reference, and the time and
 peak memory per method. With --agreement it also compares each method's rooms with the thesis implementation's,
 room by room (the IoU of the method's room k with reference_rooms.png's room k; 1 when both are empty), per case
-and by number of closed doors, next to the IoU against the truth. Any folder in the benchmark's layout works, e.g. the cases of make_closed_door_corpus
-(whose cases.csv has a `part` column: --part validation).
+and by number of closed doors, next to the IoU against the truth. Any folder in the benchmark's layout works,
+e.g. the cases of make_closed_door_corpus (whose cases.csv has a `part` column: --part validation).
 
 Peak memory is the maximum resident set size of each command as measured by `/usr/bin/time -f %M` (GNU time),
 which wraps every run. resource.getrusage(RUSAGE_CHILDREN) is not used: on Linux a child started by this
@@ -429,7 +429,7 @@ def print_agreement(cases, methods, runs):
     print()
 
     def rooms_of(method, selected):
-        return [value for i in selected if runs[method][i].agreement is not None for value in runs[method][i].agreement]
+        return [value for i in selected for value in (runs[method][i].agreement or [])]
 
     print("By number of closed doors (agreement: mean over the rooms)")
     print("doors  rooms%s%s" % (header, "ref IoU".rjust(width)))

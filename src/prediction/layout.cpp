@@ -660,13 +660,14 @@ std::vector<DoorStart> placeDoors(const common::OccupancyGrid& map, const std::v
     ImageSegment edge;
     bool horizontal;
   };
-  // The IN/OUT edges, and the others with their more unknown cell in out_cell (for door_start_fallback).
+  // The IN/OUT edges, and with door_start_fallback the others, their more unknown cell in out_cell.
   std::vector<Candidate> candidates, other_edges;
   for (int cell = 0; cell < grid.size(); ++cell)
     for (int other : {grid.column(cell) + 1 < grid.columns() ? cell + 1 : -1,
                       grid.row(cell) + 1 < grid.rows() ? cell + grid.columns() : -1}) {
       if (other < 0) continue;
       const bool in_out = grid.cells[cell].out != grid.cells[other].out;
+      if (!in_out && !options.door_start_fallback) continue;
       const bool cell_first = in_out ? grid.cells[cell].out
                                      : grid.cells[cell].unknown_fraction >= grid.cells[other].unknown_fraction;
       Candidate candidate;
@@ -705,7 +706,7 @@ std::vector<DoorStart> placeDoors(const common::OccupancyGrid& map, const std::v
     };
     find_nearest(candidates, true);
     if (best == nullptr) find_nearest(candidates, false);
-    if (best == nullptr && options.door_start_fallback) find_nearest(other_edges, true);
+    if (best == nullptr) find_nearest(other_edges, true);  // empty without door_start_fallback
     if (best == nullptr) {
       start.problem = "no cell edge between explored and unknown space within " +
                       common::formatNumber(options.door_search_radius) + " m of the door";

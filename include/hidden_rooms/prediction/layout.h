@@ -48,7 +48,7 @@ struct LayoutOptions {
   double affinity_sigma = 0.1;             // affinity of adjacent cells = exp(-wall fraction / sigma)
   double dbscan_eps = 0.85;                // DBSCAN radius on the distance 1 - affinity, in (0, 1)
   int dbscan_min_points = 1;               // DBSCAN core-point size (the cell itself counts)
-  bool door_start_fallback = false;       // no IN/OUT edge: the more unknown cell of the nearest parallel edge
+  bool door_start_fallback = false;        // no IN/OUT edge: the more unknown cell of the nearest parallel edge
   double door_search_radius = 2.0;         // m: a door's IN/OUT cell edge must be this close
 };
 
