@@ -1,6 +1,7 @@
 #include "test_util.h"
 
 #include <fstream>
+#include <functional>
 #include <thread>
 #include <chrono>
 #include <sstream>
@@ -168,13 +169,17 @@ void syntheticHiddenRoomA(common::OccupancyGrid* map, common::DoorsFile* doors, 
   truth->setTo(1, room_a);
 }
 
-double benchmarkMeanIou(const std::string& method, int* cases) {
+namespace {
+
+// Runs `method` on every valid case of the shared closed-door benchmark; `score` gets the case's folder, request
+// and room labels (roomLabels).
+void forEachBenchmarkCase(
+    const std::string& method,
+    const std::function<void(const std::string&, const prediction::PredictionRequest&, const cv::Mat&)>& score) {
   const std::string root = sharedDir() + "/data/closed_door_benchmark";
   std::ifstream csv(root + "/cases.csv");
   std::string line;
   std::getline(csv, line);  // header: env,case,closed_doors_nominal,doors_found,valid,...
-  double total = 0.0;
-  int scored = 0;
   const auto predictor = prediction::makeRoomPredictor(method);
   while (std::getline(csv, line)) {
     std::vector<std::string> fields;
@@ -186,14 +191,42 @@ double benchmarkMeanIou(const std::string& method, int* cases) {
     request.map = common::loadMap(dir + "/map.yaml");
     request.doors = common::loadDoors(dir + "/doors.yaml");
     const prediction::PredictionResult result = predictor->predict(request);
-    const cv::Mat truth = cv::imread(dir + "/gt_rooms.png", cv::IMREAD_UNCHANGED);
-    total += evaluation::scoreRooms(prediction::roomLabels(request.map, request.doors, result.rooms), truth,
-                                    static_cast<int>(request.doors.doors.size()))
-                 .mean_iou;
-    ++scored;
+    score(dir, request, prediction::roomLabels(request.map, request.doors, result.rooms));
   }
+}
+
+}  // namespace
+
+double benchmarkMeanIou(const std::string& method, int* cases) {
+  double total = 0.0;
+  int scored = 0;
+  forEachBenchmarkCase(method, [&](const std::string& dir, const prediction::PredictionRequest& request,
+                                   const cv::Mat& labels) {
+    const cv::Mat truth = cv::imread(dir + "/gt_rooms.png", cv::IMREAD_UNCHANGED);
+    total += evaluation::scoreRooms(labels, truth, static_cast<int>(request.doors.doors.size())).mean_iou;
+    ++scored;
+  });
   if (cases != nullptr) *cases = scored;
   return scored > 0 ? total / scored : 0.0;
+}
+
+double benchmarkAgreement(const std::string& method, int* rooms) {
+  double total = 0.0;
+  int compared = 0;
+  forEachBenchmarkCase(method, [&](const std::string& dir, const prediction::PredictionRequest& request,
+                                   const cv::Mat& labels) {
+    const cv::Mat reference = cv::imread(dir + "/reference_rooms.png", cv::IMREAD_UNCHANGED);
+    if (reference.empty()) return;
+    const int doors = static_cast<int>(request.doors.doors.size());
+    const evaluation::RoomScores scores = evaluation::scoreRooms(labels, reference, doors);
+    for (int k = 1; k <= doors; ++k) {
+      const bool both_empty = cv::countNonZero(labels == k) == 0 && cv::countNonZero(reference == k) == 0;
+      total += both_empty ? 1.0 : scores.iou[k - 1];
+      ++compared;
+    }
+  });
+  if (rooms != nullptr) *rooms = compared;
+  return compared > 0 ? total / compared : 0.0;
 }
 
 }  // namespace hidden_rooms::testing

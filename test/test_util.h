@@ -109,4 +109,9 @@ void syntheticHiddenRoomA(common::OccupancyGrid* map, common::DoorsFile* doors, 
 // Counts the cases in `cases` when given.
 double benchmarkMeanIou(const std::string& method, int* cases = nullptr);
 
+// Room-by-room agreement of a method with the thesis implementation's rooms (reference_rooms.png) over the valid
+// benchmark cases that have them, as scripts/benchmark_closed_doors.py --agreement scores it: per door the IoU of the
+// two rooms, 1 when both are empty, then the mean over all rooms. Counts the rooms in `rooms` when given.
+double benchmarkAgreement(const std::string& method, int* rooms = nullptr);
+
 }  // namespace hidden_rooms::testing

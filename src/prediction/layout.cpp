@@ -48,13 +48,17 @@ const common::OptionTable<LayoutOptions>& layoutOptionTable() {
        "m: extended lines this close become one (no sliver cells)", common::atLeast(0)},
       {"door_pair_lines", &O::door_pair_lines, "add Algorithm 1's lines between pairs of closed doors"},
       {"boundary_offset", &O::boundary_offset,
-       "m: boundary lines outside the segments' bounding box (20 px)", common::above(0)},
+       "m: boundary lines outside the bounding box (20 px)", common::above(0)},
       {"out_unknown_fraction", &O::out_unknown_fraction,
        "a cell with a larger fraction of unknown pixels is OUT", common::between(0, 1)},
+      {"explored_outline", &O::explored_outline,
+       "1: pixels outside the largest free region's outline count as unknown, the bounding box takes it in"},
       {"wall_coverage_band", &O::wall_coverage_band,
        "m: occupied pixels this close to an edge cover it", common::atLeast(0)},
       {"affinity_sigma", &O::affinity_sigma,
        "affinity of adjacent cells = exp(-wall fraction / sigma)", common::above(0)},
+      {"affinity_normalized", &O::affinity_normalized,
+       "1: DBSCAN's affinity is the reference code's D^-1 L, made symmetric; 0: L itself"},
       {"dbscan_eps", &O::dbscan_eps, "DBSCAN radius on the distance 1 - affinity, in (0, 1)", {0, 1, true, true}},
       {"dbscan_min_points", &O::dbscan_min_points,
        "DBSCAN core-point size (the cell itself counts)", common::atLeast(1)},
@@ -547,7 +551,41 @@ double coveredFraction(const std::vector<int>& prefix, int from, int to) {
   return static_cast<double>(prefix[b] - prefix[a]) / (to - from);
 }
 
-void buildGrid(const common::OccupancyGrid& map, const LayoutOptions& options, Layout* layout) {
+// Integral image of the non-zero pixels of `mask`.
+cv::Mat1i pixelCountIntegral(const cv::Mat1b& mask) {
+  cv::Mat1i integral;
+  cv::integral(mask / 255, integral, CV_32S);
+  return integral;
+}
+
+// Share of `rect` outside: the pixels of `inside` (= rect & image) counted by `integral`, plus every pixel of
+// `rect` past the image.
+double outsideFraction(const cv::Mat1i& integral, const cv::Rect& inside, const cv::Rect& rect) {
+  double count = static_cast<double>(rect.area()) - inside.area();
+  if (inside.area() > 0)
+    count += integral(inside.br().y, inside.br().x) - integral(inside.y, inside.br().x) -
+             integral(inside.br().y, inside.x) + integral(inside.y, inside.x);
+  return count / rect.area();
+}
+
+// The explored area as the reference code sees it: the largest 8-connected region of free pixels with everything
+// its outer outline encloses, 255 inside, 0 elsewhere.
+cv::Mat1b exploredOutline(const common::OccupancyGrid& map) {
+  std::vector<std::vector<cv::Point>> contours;
+  cv::findContours(cv::Mat1b(map.cells == common::OccupancyGrid::kFree), contours, cv::RETR_EXTERNAL,
+                   cv::CHAIN_APPROX_SIMPLE);
+  cv::Mat1b inside(map.cells.size(), 0);
+  if (contours.empty()) return inside;
+  const auto largest = std::max_element(contours.begin(), contours.end(), [](const auto& a, const auto& b) {
+    return cv::contourArea(a) < cv::contourArea(b);
+  });
+  cv::drawContours(inside, contours, static_cast<int>(largest - contours.begin()), 255, cv::FILLED);
+  return inside;
+}
+
+// `explored`: the explored outline (exploredOutline), or empty when pixels outside it do not count as unknown.
+void buildGrid(const common::OccupancyGrid& map, const LayoutOptions& options, const cv::Mat1b& explored,
+               Layout* layout) {
   CellGrid& grid = layout->grid;
   grid = CellGrid();
   for (const ExtendedLine& line : layout->lines)
@@ -558,8 +596,10 @@ void buildGrid(const common::OccupancyGrid& map, const LayoutOptions& options, L
   grid.ys.erase(std::unique(grid.ys.begin(), grid.ys.end()), grid.ys.end());
 
   const cv::Rect image(0, 0, map.width(), map.height());
-  cv::Mat1i unknown_integral;
-  cv::integral(cv::Mat1b(map.cells == common::OccupancyGrid::kUnknown) / 255, unknown_integral, CV_32S);
+  const cv::Mat1b unknown = map.cells == common::OccupancyGrid::kUnknown;
+  const cv::Mat1i unknown_integral = pixelCountIntegral(unknown);
+  const cv::Mat1i outside_integral =
+      explored.empty() ? unknown_integral : pixelCountIntegral(unknown | ~explored);
   const int columns = grid.columns(), rows = grid.rows();
   grid.cells.resize(static_cast<size_t>(columns) * rows);
   for (int j = 0; j < rows; ++j)
@@ -567,13 +607,9 @@ void buildGrid(const common::OccupancyGrid& map, const LayoutOptions& options, L
       LayoutCell& cell = grid.cells[grid.index(i, j)];
       cell.rect = cv::Rect(grid.xs[i], grid.ys[j], grid.xs[i + 1] - grid.xs[i], grid.ys[j + 1] - grid.ys[j]);
       cell.border = i == 0 || j == 0 || i == columns - 1 || j == rows - 1;
-      const cv::Rect inside = cell.rect & image;
-      double unknown = static_cast<double>(cell.rect.area()) - inside.area();  // past the image: unknown
-      if (inside.area() > 0)
-        unknown += unknown_integral(inside.br().y, inside.br().x) - unknown_integral(inside.y, inside.br().x) -
-                   unknown_integral(inside.br().y, inside.x) + unknown_integral(inside.y, inside.x);
-      cell.unknown_fraction = unknown / cell.rect.area();
-      cell.out = cell.unknown_fraction > options.out_unknown_fraction;
+      cell.unknown_fraction = outsideFraction(unknown_integral, cell.rect & image, cell.rect);
+      cell.outside_fraction = outsideFraction(outside_integral, cell.rect & image, cell.rect);
+      cell.out = cell.outside_fraction > options.out_unknown_fraction;
     }
 
   // Wall fraction of every inner edge: the share of its pixels with an occupied pixel within the band.
@@ -593,21 +629,28 @@ void buildGrid(const common::OccupancyGrid& map, const LayoutOptions& options, L
   }
 }
 
-// DBSCAN of the IN cells. Distance between edge-adjacent cells: 1 - exp(-w / sigma) with w the wall fraction of their
-// shared edge (the affinity L of docs/method.md#rooms-of-in-cells turned into a distance); any other pair of
+// DBSCAN of the IN cells (docs/method.md#rooms-of-in-cells). Affinity of edge-adjacent IN cells: L = exp(-w / sigma)
+// with w the wall fraction of their shared edge; with affinity_normalized, M = (L / d_a + L / d_b) / 2 with d the
+// cell's degree (1 for itself plus L to each edge-adjacent IN cell), else M = L. Distance 1 - M; any other pair of
 // distinct cells has affinity 0, distance 1 > eps, so a neighbourhood is the cell itself plus its edge-adjacent IN
-// cells with w <= -sigma ln(1 - eps) (0.19 with the defaults). With min_points 1 the rooms are the connected components
-// of that graph. DBSCAN's noise cells (possible with min_points > 1) each become a room of their own, so that every IN
-// cell has a room.
+// cells with M >= 1 - eps. With min_points 1 the rooms are the connected components of that graph. DBSCAN's noise
+// cells (possible with min_points > 1) each become a room of their own, so that every IN cell has a room.
 int segmentRooms(const LayoutOptions& options, CellGrid* grid) {
   const int count = grid->size();
   const int min_points = static_cast<int>(std::lround(options.dbscan_min_points));
+  const auto affinity = [&](int a, int b) { return std::exp(-grid->wallFraction(a, b) / options.affinity_sigma); };
+  std::vector<double> degree(count, 1.0);
+  for (int cell = 0; cell < count; ++cell)
+    if (!grid->cells[cell].out)
+      for (int other : grid->edgeNeighbours(cell))
+        if (!grid->cells[other].out) degree[cell] += affinity(cell, other);
   auto neighbourhood = [&](int cell) {
     std::vector<int> near{cell};
     for (int other : grid->edgeNeighbours(cell)) {
       if (grid->cells[other].out) continue;
-      const double distance = 1.0 - std::exp(-grid->wallFraction(cell, other) / options.affinity_sigma);
-      if (distance <= options.dbscan_eps) near.push_back(other);
+      const double l = affinity(cell, other);
+      const double m = options.affinity_normalized ? 0.5 * (l / degree[cell] + l / degree[other]) : l;
+      if (1.0 - m <= options.dbscan_eps) near.push_back(other);
     }
     return near;
   };
@@ -763,9 +806,11 @@ Layout analyzeLayout(const common::OccupancyGrid& map, const std::vector<common:
   clusterWalls(toPixelDistance(options.wall_cluster_distance, resolution), options.wall_chaining,
                options.diagonal_limit, &layout);
 
-  // Bounding box of the segments (the whole image when there are none) and the boundary lines around it.
+  // Bounding box of the segments (the whole image when there are none), with explored_outline of the explored
+  // outline too, and the boundary lines around it.
+  const cv::Mat1b explored = options.explored_outline ? exploredOutline(map) : cv::Mat1b();
   if (layout.segments.empty()) {
-    layout.segment_box = cv::Rect2d(0, 0, map.width(), map.height());
+    layout.bounding_box = cv::Rect2d(0, 0, map.width(), map.height());
   } else {
     double x0 = std::numeric_limits<double>::infinity(), y0 = x0, x1 = -x0, y1 = -x0;
     for (const ImageSegment& s : layout.segments)
@@ -775,13 +820,15 @@ Layout analyzeLayout(const common::OccupancyGrid& map, const std::vector<common:
         x1 = std::max(x1, p.x());
         y1 = std::max(y1, p.y());
       }
-    layout.segment_box = cv::Rect2d(x0, y0, x1 - x0, y1 - y0);
+    layout.bounding_box = cv::Rect2d(x0, y0, x1 - x0, y1 - y0);
+    if (!explored.empty() && cv::countNonZero(explored) > 0)
+      layout.bounding_box |= cv::Rect2d(cv::boundingRect(explored));
   }
   const int offset = toPixels(options.boundary_offset, resolution, 1);
-  const cv::Rect boundary(cv::Point(static_cast<int>(std::floor(layout.segment_box.x)) - offset,
-                                    static_cast<int>(std::floor(layout.segment_box.y)) - offset),
-                          cv::Point(static_cast<int>(std::ceil(layout.segment_box.br().x)) + offset,
-                                    static_cast<int>(std::ceil(layout.segment_box.br().y)) + offset));
+  const cv::Rect boundary(cv::Point(static_cast<int>(std::floor(layout.bounding_box.x)) - offset,
+                                    static_cast<int>(std::floor(layout.bounding_box.y)) - offset),
+                          cv::Point(static_cast<int>(std::ceil(layout.bounding_box.br().x)) + offset,
+                                    static_cast<int>(std::ceil(layout.bounding_box.br().y)) + offset));
 
   const double merge_distance = toPixelDistance(options.line_merge_distance, resolution);
   std::vector<ExtendedLine> lines = wallLines(layout, merge_distance);
@@ -810,11 +857,11 @@ Layout analyzeLayout(const common::OccupancyGrid& map, const std::vector<common:
   const std::vector<ExtendedLine> merged_vertical = mergeLines(vertical, merge_distance, layout);
   layout.lines.insert(layout.lines.end(), merged_vertical.begin(), merged_vertical.end());
 
-  buildGrid(map, options, &layout);
+  buildGrid(map, options, explored, &layout);
   layout.room_count = segmentRooms(options, &layout.grid);
   layout.doors = placeDoors(map, closed_doors, options, layout.grid);
 
-  if (!debug_dir.empty()) writeLayoutDebugImages(debug_dir, map, closed_doors, grey, edges, layout);
+  if (!debug_dir.empty()) writeLayoutDebugImages(debug_dir, map, closed_doors, grey, edges, explored, layout);
   return layout;
 }
 

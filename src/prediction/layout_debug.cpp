@@ -81,7 +81,7 @@ void blend(cv::Mat3b* canvas, const cv::Rect& rect, const cv::Scalar& colour, do
   cv::addWeighted(region, 1.0 - alpha, tint, alpha, 0.0, region);
 }
 
-// segments.png: the Hough segments in red over the half-faded map.
+// 02_segments.png: the Hough segments in red over the half-faded map.
 cv::Mat3b segmentsImage(const DebugCanvas& canvas, const Layout& layout) {
   cv::Mat3b segments = canvas.map(0.5);
   for (const ImageSegment& s : layout.segments)
@@ -89,7 +89,27 @@ cv::Mat3b segmentsImage(const DebugCanvas& canvas, const Layout& layout) {
   return segments;
 }
 
-// angular_clusters.png: the segments coloured by angular cluster, with the clusters' angles listed.
+// 03_explored_outline.png: the explored outline (the reference code's outer contour of the largest free region) filled light green with its
+// contour in dark green, over the half-faded map, and the bounding box the boundary lines are placed around in blue;
+// without explored_outline (`explored` empty) the box alone.
+cv::Mat3b exploredOutlineImage(const DebugCanvas& canvas, const Layout& layout, const cv::Mat1b& explored) {
+  cv::Mat3b outline = canvas.map(0.5);
+  if (!explored.empty()) {
+    cv::Mat1b placed = cv::Mat1b::zeros(outline.size());
+    explored.copyTo(placed(canvas.at(cv::Rect(cv::Point(0, 0), explored.size()))));
+    cv::Mat3b tinted = outline * 0.6 + cv::Scalar(60, 160, 60) * 0.4;
+    tinted.copyTo(outline, placed);
+    std::vector<std::vector<cv::Point>> contours;
+    cv::findContours(placed, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE);
+    cv::drawContours(outline, contours, -1, cv::Scalar(0, 110, 0), 1);
+  }
+  const cv::Rect2d& box = layout.bounding_box;
+  cv::rectangle(outline, canvas.at(common::Point2(box.x, box.y)), canvas.at(common::Point2(box.br().x, box.br().y)),
+                cv::Scalar(200, 80, 0), 1);
+  return outline;
+}
+
+// 04_angular_clusters.png: the segments coloured by angular cluster, with the clusters' angles listed.
 cv::Mat3b angularClustersImage(const DebugCanvas& canvas, const Layout& layout) {
   cv::Mat3b angular = canvas.map(0.7);
   for (size_t s = 0; s < layout.segments.size(); ++s)
@@ -104,7 +124,7 @@ cv::Mat3b angularClustersImage(const DebugCanvas& canvas, const Layout& layout) 
   return angular;
 }
 
-// walls.png: per wall its segments in a light shade of its colour and its representative segment.
+// 05_walls.png: per wall its segments in a light shade of its colour and its representative segment.
 cv::Mat3b wallsImage(const DebugCanvas& canvas, const Layout& layout) {
   cv::Mat3b walls = canvas.map(0.7);
   for (size_t w = 0; w < layout.walls.size(); ++w) {
@@ -117,7 +137,7 @@ cv::Mat3b wallsImage(const DebugCanvas& canvas, const Layout& layout) {
   return walls;
 }
 
-// extended_lines.png: the extended lines coloured by source (with a legend) and the closed doors as red circles.
+// 06_extended_lines.png: the extended lines coloured by source (with a legend) and the closed doors as red circles.
 cv::Mat3b extendedLinesImage(const DebugCanvas& canvas, const common::OccupancyGrid& map,
                              const std::vector<common::MapDoor>& doors, const Layout& layout) {
   const CellGrid& grid = layout.grid;
@@ -143,7 +163,7 @@ cv::Mat3b extendedLinesImage(const DebugCanvas& canvas, const common::OccupancyG
   return lines;
 }
 
-// cells.png: IN white, OUT grey, border cells tinted orange; the map's walls in black; grid lines light blue;
+// 07_cells.png: IN white, OUT grey, border cells tinted orange; the map's walls in black; grid lines light blue;
 // the faded map past the grid.
 cv::Mat3b cellsImage(const DebugCanvas& canvas, const Layout& layout) {
   cv::Mat3b cells = canvas.map(0.6);
@@ -157,7 +177,7 @@ cv::Mat3b cellsImage(const DebugCanvas& canvas, const Layout& layout) {
   return cells;
 }
 
-// rooms.png: IN cells coloured by room, OUT cells grey (border cells darker).
+// 08_rooms.png: IN cells coloured by room, OUT cells grey (border cells darker).
 cv::Mat3b roomsImage(const DebugCanvas& canvas, const Layout& layout) {
   cv::Mat3b rooms = canvas.map(0.6);
   for (const LayoutCell& cell : layout.grid.cells) {
@@ -171,7 +191,7 @@ cv::Mat3b roomsImage(const DebugCanvas& canvas, const Layout& layout) {
   return rooms;
 }
 
-// start_cells.png: per door its start cell tinted in its colour and its edge in red, or a red cross where it was
+// 09_start_cells.png: per door its start cell tinted in its colour and its edge in red, or a red cross where it was
 // not placed; each labelled with its id.
 cv::Mat3b startCellsImage(const DebugCanvas& canvas, const common::OccupancyGrid& map,
                           const std::vector<common::MapDoor>& doors, const Layout& layout) {
@@ -196,22 +216,31 @@ cv::Mat3b startCellsImage(const DebugCanvas& canvas, const common::OccupancyGrid
 
 }  // namespace
 
+const std::vector<std::string>& layoutDebugImageNames() {
+  static const std::vector<std::string> names{
+      "01_edges.png",  "02_segments.png",       "03_explored_outline.png", "04_angular_clusters.png", "05_walls.png",
+      "06_extended_lines.png", "07_cells.png", "08_rooms.png",            "09_start_cells.png"};
+  return names;
+}
+
 void writeLayoutDebugImages(const std::string& dir, const common::OccupancyGrid& map,
                             const std::vector<common::MapDoor>& closed_doors, const cv::Mat1b& grey,
-                            const cv::Mat1b& edges, const Layout& layout) {
+                            const cv::Mat1b& edges, const cv::Mat1b& explored, const Layout& layout) {
   std::error_code error;
   std::filesystem::create_directories(dir, error);
   if (!std::filesystem::is_directory(dir)) throw common::InputError(dir, "cannot create debug folder");
 
   const DebugCanvas canvas(layout, grey);
-  writeImage(dir, "edges.png", edges);
-  writeImage(dir, "segments.png", segmentsImage(canvas, layout));
-  writeImage(dir, "angular_clusters.png", angularClustersImage(canvas, layout));
-  writeImage(dir, "walls.png", wallsImage(canvas, layout));
-  writeImage(dir, "extended_lines.png", extendedLinesImage(canvas, map, closed_doors, layout));
-  writeImage(dir, "cells.png", cellsImage(canvas, layout));
-  writeImage(dir, "rooms.png", roomsImage(canvas, layout));
-  writeImage(dir, "start_cells.png", startCellsImage(canvas, map, closed_doors, layout));
+  const std::vector<cv::Mat> images{edges,
+                                    segmentsImage(canvas, layout),
+                                    exploredOutlineImage(canvas, layout, explored),
+                                    angularClustersImage(canvas, layout),
+                                    wallsImage(canvas, layout),
+                                    extendedLinesImage(canvas, map, closed_doors, layout),
+                                    cellsImage(canvas, layout),
+                                    roomsImage(canvas, layout),
+                                    startCellsImage(canvas, map, closed_doors, layout)};
+  for (size_t k = 0; k < images.size(); ++k) writeImage(dir, layoutDebugImageNames()[k], images[k]);
 }
 
 }  // namespace hidden_rooms::prediction

@@ -138,6 +138,8 @@ const common::OptionTable<ThesisOptions>& thesisOptionTable() {
       {"thesis_max_exchangeable", &O::max_exchangeable,
        "exchangeable cells per pair (2^n assignments are scored)", common::between(0, 20)},
       {"thesis_border_rooms", &O::border_rooms, "border-cell rooms grow into squares (docs/method.md#border-rooms)"},
+      {"thesis_border_depth_average", &O::border_depth_average,
+       "1: border squares growing the same way share their average side as depth; 0: each keeps its own side"},
       {"thesis_border_cells_free", &O::border_cells_free, "OUT border cells count as free in fe and oc"},
   };
   return table;
@@ -195,7 +197,7 @@ std::vector<ThesisRoomCells> thesisRoomCells(const Layout& layout, const ThesisO
       Square square{static_cast<int>(r), BorderSide()};
       if (borderSide(grid, layout.doors[room.door], room.cells, &square.side)) squares.push_back(square);
     }
-  // Depth: the average of the squares' sides, per growth direction.
+  // Depth: the square's own side, or the average of the sides of the squares growing the same way.
   for (const Growth growth : {Growth::kUp, Growth::kDown, Growth::kLeft, Growth::kRight}) {
     double sum = 0.0;
     int count = 0;
@@ -205,12 +207,12 @@ std::vector<ThesisRoomCells> thesisRoomCells(const Layout& layout, const ThesisO
         ++count;
       }
     if (count == 0) continue;
-    const int depth = static_cast<int>(std::lround(sum / count));
+    const int average = static_cast<int>(std::lround(sum / count));
     for (const Square& s : squares)
       if (s.side.growth == growth) {
         ThesisRoomCells& out = result[rooms[s.room].door];
         out.border_room = true;
-        out.square = squareRect(s.side, depth);
+        out.square = squareRect(s.side, options.border_depth_average ? average : s.side.high - s.side.low);
       }
   }
 
@@ -309,7 +311,7 @@ PredictionResult ThesisPredictor::predict(const PredictionRequest& request) cons
       if (x >= 0 && x < overlay.cols) cv::line(overlay, {x, 0}, {x, overlay.rows - 1}, cv::Scalar(230, 200, 150), 1);
     for (int y : grid.ys)
       if (y >= 0 && y < overlay.rows) cv::line(overlay, {0, y}, {overlay.cols - 1, y}, cv::Scalar(230, 200, 150), 1);
-    const std::string path = request.debug_dir + "/thesis_rooms.png";
+    const std::string path = request.debug_dir + "/10_thesis_rooms.png";  // after the layout's stages
     common::writeImage(path, overlay);
   }
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();

@@ -165,8 +165,8 @@ void RoomPredictorNode::predict(const PredictRooms::Request& request, PredictRoo
   predicted_map_publisher_.publish(response->completed_map);
   visualization_msgs::MarkerArray markers = toMarkers(core.map, core.doors, result.rooms, labels, frame, stamp);
   if (options_.publish_debug) {
-    prediction::LayoutOptions layout_options;
-    prediction::applyLayoutParameters(core.parameters, &layout_options);
+    prediction::LayoutOptions layout_options;  // the layout the method ran on, with its own defaults
+    prediction::applyLayoutParameters(prediction::resolveParameters(*predictor, core.parameters), &layout_options);
     const prediction::Layout layout = prediction::analyzeLayout(core.map, core.doors.doors, layout_options);
     const visualization_msgs::MarkerArray debug = toDebugMarkers(core.map, layout, frame, stamp);
     markers.markers.insert(markers.markers.end(), debug.markers.begin(), debug.markers.end());

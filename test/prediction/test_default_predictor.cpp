@@ -349,6 +349,8 @@ TEST(DefaultPredictor, LeavesTheUnseenWallsOutOfTheRooms) {
   cv::Mat1w truth = cv::Mat1w::zeros(states.size());  // 2 rows of the corridor wall, unknown
   truth(cv::Rect(152, 8, 40, 64)).setTo(1);
   Synthetic s = syntheticFromStates(states, truth, {{172, 77}});
+  s.request.parameters["default_network"] = 0;  // the wall-fitted rectangle alone, so that only the margin differs
+  s.request.parameters["default_grown_area_ratio"] = 1000.0;
   const PredictionResult result = makeRoomPredictor("default")->predict(s.request);
   ASSERT_EQ(result.rooms.size(), 1u);
   EXPECT_NEAR(result.rooms[0].terms.at("wall_margin"), 0.30, 1e-9);
@@ -526,11 +528,11 @@ TEST(DefaultPredictor, FarKnownSpaceDoesNotSetTheDepth) {
 }
 
 // Mean IoU of `default` over the benchmark's 44 valid cases; the floor sits a little under the measured mean
-// (0.724), so that a regression fails.
+// (0.734), so that a regression fails.
 TEST(DefaultPredictor, KeepsItsAccuracyOnTheBenchmark) {
   HIDDEN_ROOMS_REQUIRE_SHARED_DATA();
   int cases = 0;
-  EXPECT_GE(testing::benchmarkMeanIou("default", &cases), 0.71);
+  EXPECT_GE(testing::benchmarkMeanIou("default", &cases), 0.72);
   EXPECT_EQ(cases, 44);
 }
 

@@ -15,6 +15,7 @@
 
 #include "hidden_rooms/common/input_error.h"
 #include "hidden_rooms/prediction/layout.h"
+#include "hidden_rooms/prediction/layout_debug.h"
 #include "hidden_rooms/prediction/structured_predictor.h"
 #include "hidden_rooms/prediction/thesis_predictor.h"
 #include "test_util.h"
@@ -217,8 +218,8 @@ TEST(Structured, RejectsUnknownParametersAndEmptyMapsAndAppliesLayoutParameters)
   request.parameters = {{"canny_aperture", 4.0}};
   EXPECT_THROW(predictor.predict(request), common::InputError);
 
-  // A layout parameter takes effect: with every cell counted IN, no door finds unknown space.
-  request.parameters = {{"out_unknown_fraction", 1.0}};
+  // Layout parameters take effect: with every cell counted IN and no fallback, no door finds unknown space.
+  request.parameters = {{"out_unknown_fraction", 1.0}, {"door_start_fallback", 0.0}};
   const PredictionResult all_in = predictor.predict(request);
   ASSERT_EQ(all_in.rooms.size(), 1u);
   EXPECT_FALSE(all_in.rooms[0].placed);
@@ -325,14 +326,16 @@ TEST(Layout, DiagonalWallsAreDroppedBeyondTheLimit) {
   EXPECT_EQ(wall_lines(0.15), 0);
 }
 
-// A door whose hidden room shows only as a small unknown pocket in a cell that is mostly free (IN): no IN/OUT edge
-// is near it, so it is not placed; with door_start_fallback it starts at the pocket's cell, across the edge it lies
-// on from the corridor.
+// A door whose hidden room shows only as a small unknown pocket in a cell that is mostly free (IN, counting unknown
+// pixels only): no IN/OUT edge is near it, so it is not placed; with door_start_fallback it starts at the pocket's
+// cell, across the edge it lies on from the corridor.
 TEST(Layout, ADoorBesideNoOutCellStartsAtTheMoreUnknownCellWithTheFallback) {
   SyntheticFloor floor = makeFloor(1);
   floor.map.cells(cv::Rect(144, 20, 136, 96)).setTo(common::OccupancyGrid::kFree);      // room B seen ...
   floor.map.cells(cv::Rect(190, 100, 50, 16)).setTo(common::OccupancyGrid::kUnknown);  // ... but a pocket
   LayoutOptions options;
+  options.explored_outline = false;
+  options.door_start_fallback = false;
   const Layout without = analyzeLayout(floor.map, floor.doors.doors, options);
   ASSERT_EQ(without.doors.size(), 1u);
   EXPECT_FALSE(without.doors[0].found);
@@ -344,11 +347,12 @@ TEST(Layout, ADoorBesideNoOutCellStartsAtTheMoreUnknownCellWithTheFallback) {
   ASSERT_TRUE(with.doors[0].found) << with.doors[0].problem;
   EXPECT_EQ(with.doors[0].start_cell, with.grid.cellAt(floor.image(212, 68)));
   EXPECT_EQ(with.doors[0].explored_cell, with.grid.cellAt(floor.image(212, 140)));
-  // The thesis method then grows the room from that cell: all of the pocket, and no known pixel.
+  // The thesis method (fallback on by default) then grows the room from that cell: all of the pocket, and no known
+  // pixel.
   PredictionRequest request;
   request.map = floor.map;
   request.doors = floor.doors;
-  request.parameters["door_start_fallback"] = 1;
+  request.parameters["explored_outline"] = 0;
   const PredictionResult result = ThesisPredictor().predict(request);
   ASSERT_EQ(result.rooms.size(), 1u);
   ASSERT_TRUE(result.rooms[0].placed) << result.rooms[0].problem;
@@ -356,6 +360,39 @@ TEST(Layout, ADoorBesideNoOutCellStartsAtTheMoreUnknownCellWithTheFallback) {
   pocket(cv::Rect(190, 100, 50, 16)).setTo(255);
   EXPECT_EQ(cv::countNonZero(pocket & ~result.rooms[0].mask), 0);
   EXPECT_EQ(cv::countNonZero(result.rooms[0].mask & (floor.map.cells != common::OccupancyGrid::kUnknown)), 0);
+}
+
+// The explored outline: room B seen apart from the explored corridor (through no open door) does not make its cell
+// IN, so the closed door between them starts there with no fallback; an unknown pocket inside the outline (a
+// closed room the corridor runs around) stays outside, so its cell is OUT.
+TEST(Layout, OnlyFreeSpaceInsideTheExploredOutlineMakesACellIn) {
+  SyntheticFloor floor = makeFloor(1);
+  floor.map.cells(cv::Rect(144, 20, 136, 96)).setTo(common::OccupancyGrid::kFree);      // room B seen apart
+  floor.map.cells(cv::Rect(190, 100, 50, 16)).setTo(common::OccupancyGrid::kUnknown);  // with a pocket
+  LayoutOptions options;
+  options.door_start_fallback = false;
+  ASSERT_TRUE(options.explored_outline);
+  const Layout layout = analyzeLayout(floor.map, floor.doors.doors, options);
+  ASSERT_TRUE(layout.doors[0].found) << layout.doors[0].problem;
+  const int room_b = layout.grid.cellAt(floor.image(212, 68));
+  EXPECT_EQ(layout.doors[0].start_cell, room_b);
+  EXPECT_TRUE(layout.grid.cells[room_b].out);
+  EXPECT_LT(layout.grid.cells[room_b].unknown_fraction, 0.2);  // IN by its unknown pixels alone
+  EXPECT_FALSE(layout.grid.cells[layout.doors[0].explored_cell].out);
+
+  // A closed square room in the middle of a free hall: inside the hall's outline, but unknown, so OUT.
+  common::OccupancyGrid hall;
+  hall.resolution = 0.05;
+  hall.cells = cv::Mat_<int8_t>(200, 200, common::OccupancyGrid::kUnknown);
+  hall.cells(cv::Rect(20, 20, 160, 160)).setTo(common::OccupancyGrid::kOccupied);
+  hall.cells(cv::Rect(24, 24, 152, 152)).setTo(common::OccupancyGrid::kFree);
+  hall.cells(cv::Rect(70, 70, 60, 60)).setTo(common::OccupancyGrid::kOccupied);
+  hall.cells(cv::Rect(74, 74, 52, 52)).setTo(common::OccupancyGrid::kUnknown);
+  const Layout around = analyzeLayout(hall, {}, options);
+  const int inner = around.grid.cellAt(common::Point2(100, 100));
+  ASSERT_GE(inner, 0);
+  EXPECT_TRUE(around.grid.cells[inner].out);
+  EXPECT_FALSE(around.grid.cells[around.grid.cellAt(common::Point2(40, 100))].out);
 }
 
 TEST(Layout, ParametersByNameValidateAndRejectUnknownNames) {
@@ -407,8 +444,8 @@ TEST(Layout, WritesEveryDebugImageAndFailsOnAnUnwritableFolder) {
   const SyntheticFloor floor = makeFloor(1);
   const std::string dir = testing::makeTempDir("layout_debug") + "/stages";
   analyzeLayout(floor.map, floor.doors.doors, LayoutOptions(), dir);
-  for (const char* name : {"edges.png", "segments.png", "angular_clusters.png", "walls.png", "extended_lines.png",
-                           "cells.png", "rooms.png", "start_cells.png"}) {
+  ASSERT_EQ(layoutDebugImageNames().size(), 9u);
+  for (const std::string& name : layoutDebugImageNames()) {
     const cv::Mat image = cv::imread(dir + "/" + name, cv::IMREAD_UNCHANGED);
     EXPECT_FALSE(image.empty()) << name;
     EXPECT_GE(image.cols, floor.map.width()) << name;
@@ -486,6 +523,7 @@ TEST(LayoutBenchmark, EveryClosedDoorOfValidCasesGetsAStartCell) {
   HIDDEN_ROOMS_REQUIRE_SHARED_DATA();
   const std::vector<BenchmarkCase> cases = validBenchmarkCases();
   ASSERT_GE(cases.size(), 40u);
+  int doors_placed = 0, fallback_starts = 0;
   for (const BenchmarkCase& benchmark : cases) {
     SCOPED_TRACE(benchmark.name);
     const common::OccupancyGrid map = common::loadMap(benchmark.dir + "/map.yaml");
@@ -494,11 +532,15 @@ TEST(LayoutBenchmark, EveryClosedDoorOfValidCasesGetsAStartCell) {
     ASSERT_EQ(layout.doors.size(), doors.doors.size());
     for (const DoorStart& start : layout.doors) {
       ASSERT_TRUE(start.found) << "door " << start.door_id << ": " << start.problem;
-      EXPECT_TRUE(layout.grid.cells[start.start_cell].out);
-      EXPECT_FALSE(layout.grid.cells[start.explored_cell].out);
       EXPECT_LE(start.distance, 2.0);
+      ++doors_placed;
+      const bool in_out = layout.grid.cells[start.start_cell].out && !layout.grid.cells[start.explored_cell].out;
+      if (!in_out) ++fallback_starts;
     }
   }
+  // The door-start fallback is for the odd door (a pocket of unknown space in a mostly explored cell).
+  std::printf("benchmark doors: %d placed, %d of them by the fallback\n", doors_placed, fallback_starts);
+  EXPECT_LE(fallback_starts * 20, doors_placed);
 }
 
 TEST(StructuredBenchmark, NeverPredictsKnownCellsAndReportsIoU) {

@@ -177,6 +177,40 @@ TEST(ThesisExpansion, NeighbouringRoomsShareABlock) {
   EXPECT_EQ(rooms[0].cells.size(), rooms[1].cells.size());  // the pair fix balances the areas
 }
 
+// Two border rooms above a corridor (row 1, IN), in the top border row, kept apart by an explored cell at column 2:
+// door 1's room slides over columns 0..1 (80 px of contact), door 2's over columns 3..6 (160 px). Each square keeps
+// its own side as depth; with thesis_border_depth_average both take the average, 120 px.
+TEST(ThesisExpansion, BorderSquaresKeepTheirOwnSideUnlessAveraged) {
+  Layout layout;
+  layout.grid = squareGrid(7, 2, 40);
+  CellGrid& grid = layout.grid;
+  for (int i = 0; i < 7; ++i) setIn(&grid, i, 1);
+  setIn(&grid, 2, 0);
+  for (int c = 0; c < grid.size(); ++c) grid.cells[c].border = grid.row(c) == 0;
+  for (int k = 0; k < 2; ++k) {
+    DoorStart door;
+    door.door_id = k + 1;
+    door.found = true;
+    const int column = k == 0 ? 1 : 4;
+    door.start_cell = grid.index(column, 0);
+    door.explored_cell = grid.index(column, 1);
+    door.edge.a = common::Point2(40 * column, 40);
+    door.edge.b = common::Point2(40 * column + 40, 40);
+    layout.doors.push_back(door);
+  }
+  const std::vector<ThesisRoomCells> own = thesisRoomCells(layout);
+  ASSERT_EQ(own.size(), 2u);
+  ASSERT_TRUE(own[0].border_room);
+  ASSERT_TRUE(own[1].border_room);
+  EXPECT_EQ(own[0].square, cv::Rect(0, 40 - 80, 80, 80));
+  EXPECT_EQ(own[1].square, cv::Rect(120, 40 - 160, 160, 160));
+  ThesisOptions averaged;
+  averaged.border_depth_average = true;
+  const std::vector<ThesisRoomCells> shared = thesisRoomCells(layout, averaged);
+  EXPECT_EQ(shared[0].square, cv::Rect(0, 40 - 120, 80, 120));
+  EXPECT_EQ(shared[1].square, cv::Rect(120, 40 - 120, 160, 120));
+}
+
 std::pair<PredictionRequest, cv::Mat1w> hiddenRoomA() {
   PredictionRequest request;
   cv::Mat1w truth;
@@ -307,12 +341,20 @@ TEST(ThesisPredictor, ParametersAreValidated) {
 }
 
 // Mean IoU over the valid cases of the shared closed-door benchmark (as scripts/benchmark_closed_doors.py
-// scores), and the largest prediction time of a case.
-// Floor a little under the measured mean (0.612 over the 44 valid cases; the thesis implementation's own
+// scores). Floor a little under the measured mean (0.628 over the 44 valid cases; the thesis implementation's own
 // predictions score 0.638 over the 42 cases that have them).
 TEST(ThesisPredictor, KeepsItsAccuracyOnTheBenchmark) {
   HIDDEN_ROOMS_REQUIRE_SHARED_DATA();
-  EXPECT_GE(testing::benchmarkMeanIou("thesis"), 0.59);
+  EXPECT_GE(testing::benchmarkMeanIou("thesis"), 0.61);
+}
+
+// Room by room, the rooms of `thesis` against the thesis implementation's (reference_rooms.png): floor a little
+// under the measured 0.849 over the 262 rooms.
+TEST(ThesisPredictor, AgreesWithTheThesisImplementationOnTheBenchmark) {
+  HIDDEN_ROOMS_REQUIRE_SHARED_DATA();
+  int rooms = 0;
+  EXPECT_GE(testing::benchmarkAgreement("thesis", &rooms), 0.83);
+  EXPECT_EQ(rooms, 262);
 }
 
 }  // namespace

@@ -1,15 +1,16 @@
 #pragma once
 
-// The project's own prediction method, "default": per closed door, one of three candidate rooms, a rectangle
-// fitted to the walls the robot saw around the door, the room grown on the layout's cell grid by the thesis's
-// method (thesis_predictor.h, with its default parameters) and the room the learned room model sees behind the
-// door (room_network.h): the one that agrees most (IoU) with the other two (mostAgreedCandidate; default_network
-// 3). Other choices: default_network 1 keeps the rectangle or the grown room, whichever agrees more with the
-// model's room; 2 the model's rooms; 0 (and every choice on maps too fine for the model: networkReads) the grown
-// room when it is at least default_grown_area_ratio times the rectangle (the rectangle stopped short, e.g. of an
-// L-shaped room). A missing candidate is never chosen. A rectangle gives up the pixels of the grown rooms kept for
-// the other doors. The growth runs on a second thread while the rectangles are fitted (predict() is still safe to
-// call from several threads).
+// The project's own prediction method, "default": per closed door, one of three candidate rooms, a rectangle fitted to
+// the walls the robot saw around the door, the room grown on the layout's cell grid by the thesis's method
+// (thesis_predictor.h, with its default constants, on a layout that keeps four choices of its own: the flat angular
+// window, bounded walls, unknown-pixel IN/OUT and DBSCAN on 1 - L; see config/layout.yaml) and the room the learned
+// room model sees behind the door (room_network.h): the one that agrees most (IoU) with the other two
+// (mostAgreedCandidate; default_network 3). Other choices: default_network 1 keeps the rectangle or the grown room,
+// whichever agrees more with the model's room; 2 the model's rooms; 0 (and every choice on maps too fine for the model:
+// networkReads) the grown room when it is at least default_grown_area_ratio times the rectangle (the rectangle stopped
+// short, e.g. of an L-shaped room). A missing candidate is never chosen. A rectangle gives up the pixels of the grown
+// rooms kept for the other doors. The growth runs on a second thread while the rectangles are fitted (predict() is
+// still safe to call from several threads).
 //
 // Turned maps: when the dominant wall direction (dominantWallAngle, modulo 90 degrees) is at least
 // default_min_rotation, the whole prediction runs on the map turned straight (walls along x and y, as the

@@ -36,19 +36,21 @@ struct LayoutOptions {
   double hough_min_line_length = 0.35;     // m: shortest segment kept (7 px at 0.05 m)
   double hough_max_line_gap = 0.15;        // m: largest gap bridged inside a segment (3 px)
   double angular_bandwidth = 0.023;        // mean-shift bandwidth: 1 - cos of the angle (kernel 1), rad (kernel 0)
-  int angular_kernel = 0;                  // 1: the reference code's biweight on 1 - cos; 0: flat window in rad
+  int angular_kernel = 1;                  // 1: the reference code's biweight on 1 - cos; 0: flat window in rad
   double wall_cluster_distance = 0.5;      // m: lateral reach of one wall's segments (10 px)
-  bool wall_chaining = false;              // true: segments chain into a wall (the reference code's); false: bounded
-  double diagonal_limit = 0.0;             // rad: angular clusters farther from both axes are dropped; 0: none
+  bool wall_chaining = true;               // true: segments chain into a wall (the reference code's); false: bounded
+  double diagonal_limit = 0.15;            // rad: angular clusters farther from both axes are dropped; 0: none
   double line_merge_distance = 0.25;       // m: extended lines this close become one (no sliver cells)
   bool door_pair_lines = true;             // add Algorithm 1's lines between pairs of closed doors
   double boundary_offset = 1.0;            // m: boundary lines outside the segments' bounding box (20 px)
   double out_unknown_fraction = 0.8;       // a cell with a larger fraction of unknown pixels is OUT
+  bool explored_outline = true;            // true: pixels outside the largest free region's outline count too
   double wall_coverage_band = 0.25;        // m: occupied pixels this close to an edge cover it
   double affinity_sigma = 0.1;             // affinity of adjacent cells = exp(-wall fraction / sigma)
+  bool affinity_normalized = true;         // DBSCAN on 1 - sym(D^-1 L) (the reference code's); false: on 1 - L
   double dbscan_eps = 0.85;                // DBSCAN radius on the distance 1 - affinity, in (0, 1)
   int dbscan_min_points = 1;               // DBSCAN core-point size (the cell itself counts)
-  bool door_start_fallback = false;        // no IN/OUT edge: the more unknown cell of the nearest parallel edge
+  bool door_start_fallback = true;         // no IN/OUT edge: the more unknown cell of the nearest parallel edge
   double door_search_radius = 2.0;         // m: a door's IN/OUT cell edge must be this close
 };
 
@@ -97,8 +99,9 @@ struct ExtendedLine {
 struct LayoutCell {
   cv::Rect rect;                  // pixels covered, image coordinates; may reach past the image
   bool border = false;            // touches a boundary line
-  bool out = false;               // OUT: more than out_unknown_fraction unknown (pixels past the image count)
-  double unknown_fraction = 0.0;
+  bool out = false;               // OUT: more than out_unknown_fraction outside (see outside_fraction)
+  double unknown_fraction = 0.0;  // unknown pixels; pixels past the image count
+  double outside_fraction = 0.0;  // = unknown_fraction, plus with explored_outline the known pixels outside the outline
   int room = -1;                  // room (DBSCAN cluster) of an IN cell; -1 for OUT cells
 };
 
@@ -135,8 +138,9 @@ struct DoorStart {
   int door_id = 0;
   bool found = false;
   std::string problem;             // why not, when !found
-  int start_cell = -1;             // the OUT cell behind the door: the hidden room's first cell
-  int explored_cell = -1;          // the IN cell on the explored side of the edge
+  int start_cell = -1;             // the OUT cell behind the door: the hidden room's first cell (door_start_fallback:
+                                   // the more unknown cell of an edge between two IN or two OUT cells)
+  int explored_cell = -1;          // the IN cell on the explored side of the edge (fallback: the other cell)
   ImageSegment edge;               // the shared edge, image coordinates
   common::Point2 position =
       common::Point2::Zero();      // the edge's centre in the map frame (metres): the door on the grid
@@ -150,7 +154,8 @@ struct Layout {
   std::vector<int> segment_angular_cluster;  // per segment, index into angular_modes
   std::vector<double> angular_modes;         // rad, in [0, pi)
   std::vector<Wall> walls;
-  cv::Rect2d segment_box;                    // bounding box of the segments' end points (image coordinates)
+  cv::Rect2d bounding_box;                   // of the segments' end points and, with explored_outline, of the
+                                             // explored outline (image coordinates)
   std::vector<ExtendedLine> lines;           // after merging; horizontal lines first, each axis sorted
   CellGrid grid;
   int room_count = 0;                        // rooms of IN cells: LayoutCell::room in [0, room_count)
@@ -158,9 +163,8 @@ struct Layout {
 };
 
 // Runs the analysis. `closed_doors` are in the map frame. When `debug_dir` is not empty it is created if
-// needed and receives edges.png, segments.png, angular_clusters.png, walls.png, extended_lines.png,
-// cells.png, rooms.png and start_cells.png; InputError when it cannot be written. Throws InputError for an
-// empty map or bad options.
+// needed and receives one image per stage (layoutDebugImageNames, layout_debug.h); InputError when it cannot be
+// written. Throws InputError for an empty map or bad options.
 Layout analyzeLayout(const common::OccupancyGrid& map, const std::vector<common::MapDoor>& closed_doors,
                      const LayoutOptions& options = LayoutOptions(), const std::string& debug_dir = "");
 

@@ -36,7 +36,8 @@ struct ThesisOptions {
   double fix_k2 = 1.0;
   int max_exchangeable = 12;           // exchangeable cells per pair (2^n assignments are scored)
   bool border_rooms = true;            // border-cell rooms grow into squares (docs/method.md#border-rooms)
-  bool border_cells_free = false;      // OUT border cells count as free in fe and oc
+  bool border_depth_average = false;   // squares growing the same way share their average side as depth
+  bool border_cells_free = true;       // OUT border cells count as free in fe and oc
 };
 
 // Every ThesisOptions field as a parameter ("thesis_ind_k1", ...) with its range, in config/prediction.yaml's order.
