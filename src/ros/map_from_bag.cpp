@@ -56,6 +56,22 @@ Pose2 interpolate(const std::vector<TimedPose>& poses, double time) {
   return {a.pose.x + f * (b.pose.x - a.pose.x), a.pose.y + f * (b.pose.y - a.pose.y), a.pose.yaw + f * dyaw};
 }
 
+// A topic or frame name without its leading slashes: older bags and drivers write "/base_scan" and "/base_link"
+// where newer ones write "base_scan" and "base_link"; tf2 takes frame ids without one.
+std::string withoutLeadingSlash(const std::string& name) {
+  const size_t first = name.find_first_not_of('/');
+  return first == std::string::npos ? std::string() : name.substr(first);
+}
+
+// The bag's topics of `datatype`, comma-separated ("none" when there are none).
+std::string topicsOfType(rosbag::Bag& bag, const std::string& datatype) {
+  std::string listed;
+  for (const rosbag::ConnectionInfo* connection : rosbag::View(bag).getConnections())
+    if (connection->datatype == datatype && listed.find(connection->topic) == std::string::npos)
+      listed += (listed.empty() ? "" : ", ") + connection->topic;
+  return listed.empty() ? "none" : listed;
+}
+
 std::string defaultConfig() {
   const std::string package = ros::package::getPath("hidden_rooms");
   return package.empty() ? std::string() : package + "/config/rbpf.ini";
@@ -63,7 +79,7 @@ std::string defaultConfig() {
 
 int run(int argc, char** argv) {
   std::string bag_path, prefix, config, scan_topic, odom_frame, base_frame, environment_path, closed, metrics_path,
-      truth_topic, comparison_path;
+      truth_topic, comparison_path, odom_topic;
   int seed = 0;
   bool quiet = false;
   po::options_description options("Options");
@@ -75,6 +91,8 @@ int run(int argc, char** argv) {
       ("scan-topic", po::value(&scan_topic)->default_value("base_scan"), "sensor_msgs/LaserScan topic")
       ("odom-frame", po::value(&odom_frame)->default_value("odom"), "odometry frame in /tf")
       ("base-frame", po::value(&base_frame)->default_value("base_link"), "robot frame in /tf")
+      ("odom-topic", po::value(&odom_topic),
+       "nav_msgs/Odometry topic to take the odometry from, for bags without odom -> base_link in /tf")
       ("environment", po::value(&environment_path), "score the map against this environment XML's rendering")
       ("closed-doors", po::value(&closed)->default_value(""), "with --environment: doors closed in the run")
       ("truth-topic", po::value(&truth_topic)->default_value("base_pose_ground_truth"),
@@ -91,8 +109,8 @@ int run(int argc, char** argv) {
           argc, argv,
           "Usage: map_from_bag BAG --out PREFIX [--config rbpf.ini] [--seed N] [--environment ENV.xml [--metrics "
           "F.yaml]]\n"
-          "Builds the mapper's map (MRPT RBPF) from the bag's scans and tf odom -> base_link, as fast as the CPU\n"
-          "allows, and writes it as map_server files. With --environment also prints map quality and trajectory\n"
+          "Builds the mapper's map (MRPT RBPF) from the bag's scans and tf odom -> base_link (or --odom-topic), as\n"
+          "fast as the CPU allows, and writes it as map_server files. With --environment also prints map quality and trajectory\n"
           "error against the rendered ground truth (true poses from --truth-topic).",
           options, positional, &values))
     return hidden_rooms::common::kExitOk;
@@ -120,14 +138,28 @@ int run(int argc, char** argv) {
   } catch (const rosbag::BagException& error) {
     throw InputError(bag_path, std::string("cannot open the bag: ") + error.what());
   }
-  const std::vector<std::string> topics{scan_topic, "/tf", "/tf_static", truth_topic};
+  // Topics and frames match with or without a leading slash.
+  scan_topic = withoutLeadingSlash(scan_topic);
+  truth_topic = withoutLeadingSlash(truth_topic);
+  odom_topic = withoutLeadingSlash(odom_topic);
+  odom_frame = withoutLeadingSlash(odom_frame);
+  base_frame = withoutLeadingSlash(base_frame);
+  std::vector<std::string> topics;
+  for (const std::string& topic : {scan_topic, std::string("tf"), std::string("tf_static"), truth_topic, odom_topic})
+    if (!topic.empty()) topics.insert(topics.end(), {topic, "/" + topic});
   rosbag::View view(bag, rosbag::TopicQuery(topics));
-  int scans_in_bag = 0;
-  for (const rosbag::ConnectionInfo* connection : view.getConnections())
-    if (connection->datatype == "sensor_msgs/LaserScan" &&
-        (connection->topic == scan_topic || connection->topic == "/" + scan_topic))
-      scans_in_bag = 1;
-  if (scans_in_bag == 0) throw InputError(bag_path, "no sensor_msgs/LaserScan on topic " + scan_topic);
+  bool scans_in_bag = false, odometry_in_bag = odom_topic.empty();
+  for (const rosbag::ConnectionInfo* connection : view.getConnections()) {
+    const std::string topic = withoutLeadingSlash(connection->topic);
+    scans_in_bag |= connection->datatype == "sensor_msgs/LaserScan" && topic == scan_topic;
+    odometry_in_bag |= connection->datatype == "nav_msgs/Odometry" && topic == odom_topic;
+  }
+  if (!scans_in_bag)
+    throw InputError(bag_path, "no sensor_msgs/LaserScan on topic " + scan_topic + " (the bag's LaserScan topics: " +
+                                   topicsOfType(bag, "sensor_msgs/LaserScan") + "; choose one with --scan-topic)");
+  if (!odometry_in_bag)
+    throw InputError(bag_path, "no nav_msgs/Odometry on topic " + odom_topic + " (the bag's Odometry topics: " +
+                                   topicsOfType(bag, "nav_msgs/Odometry") + ")");
   const double bag_start = view.getBeginTime().toSec(), bag_end = view.getEndTime().toSec();
   const double bag_seconds = std::max(bag_end - bag_start, 1e-9);
 
@@ -137,8 +169,8 @@ int run(int argc, char** argv) {
   std::vector<double> scan_times;
   std::vector<Pose2> estimate;
   std::vector<std::pair<double, hidden_rooms::common::RangeScan>> inserted_scans;  // for the observed cells
-  int processed = 0, dropped = 0, received = 0, without_returns = 0;
-  std::string last_tf_error;
+  int processed = 0, dropped = 0, received = 0, without_returns = 0, without_mount = 0;
+  std::string last_tf_error, last_mount_error;
   const Clock::time_point start = Clock::now();
   Clock::time_point last_progress = start;
 
@@ -148,11 +180,19 @@ int run(int argc, char** argv) {
       ++without_returns;
       return;
     }
+    const std::string laser_frame = withoutLeadingSlash(scan.header.frame_id);
+    Pose2 sensor;
+    try {
+      sensor = hidden_rooms::fromRos(tf_buffer.lookupTransform(base_frame, laser_frame, ros::Time(0)).transform);
+    } catch (const tf2::TransformException& error) {
+      ++dropped;
+      ++without_mount;
+      last_mount_error = error.what();
+      return;
+    }
     try {
       const Pose2 odometry =
           hidden_rooms::fromRos(tf_buffer.lookupTransform(odom_frame, base_frame, scan.header.stamp).transform);
-      const Pose2 sensor =
-          hidden_rooms::fromRos(tf_buffer.lookupTransform(base_frame, scan.header.frame_id, ros::Time(0)).transform);
       const bool inserted = mapper.addScan(odometry, hidden_rooms::toMrptScan(scan, sensor));
       ++processed;
       if (!environment_path.empty()) {
@@ -170,15 +210,31 @@ int run(int argc, char** argv) {
   };
 
   for (const rosbag::MessageInstance& message : view) {
+    const std::string topic = withoutLeadingSlash(message.getTopic());
     if (const auto tf = message.instantiate<tf2_msgs::TFMessage>()) {
-      const bool is_static = message.getTopic() == "/tf_static";
-      for (const geometry_msgs::TransformStamped& transform : tf->transforms)
-        tf_buffer.setTransform(transform, "bag", is_static);
+      for (geometry_msgs::TransformStamped transform : tf->transforms) {
+        transform.header.frame_id = withoutLeadingSlash(transform.header.frame_id);
+        transform.child_frame_id = withoutLeadingSlash(transform.child_frame_id);
+        tf_buffer.setTransform(transform, "bag", topic == "tf_static");
+      }
     } else if (const auto scan = message.instantiate<sensor_msgs::LaserScan>()) {
+      if (topic != scan_topic) continue;
       pending.push_back(scan);
       ++received;
     } else if (const auto odometry = message.instantiate<nav_msgs::Odometry>()) {
-      true_poses.push_back({odometry->header.stamp.toSec(), hidden_rooms::fromRos(odometry->pose.pose)});
+      if (topic == odom_topic) {  // the odometry as the transform odom_frame -> base_frame at its stamp
+        geometry_msgs::TransformStamped transform;
+        transform.header.stamp = odometry->header.stamp;
+        transform.header.frame_id = odom_frame;
+        transform.child_frame_id = base_frame;
+        transform.transform.translation.x = odometry->pose.pose.position.x;
+        transform.transform.translation.y = odometry->pose.pose.position.y;
+        transform.transform.translation.z = odometry->pose.pose.position.z;
+        transform.transform.rotation = odometry->pose.pose.orientation;
+        tf_buffer.setTransform(transform, "bag", false);
+      }
+      if (topic == truth_topic)
+        true_poses.push_back({odometry->header.stamp.toSec(), hidden_rooms::fromRos(odometry->pose.pose)});
     }
     // A scan is processed once the odometry after its stamp is in the buffer (tf at the scan's time).
     while (!pending.empty() && tf_buffer.canTransform(odom_frame, base_frame, pending.front()->header.stamp)) {
@@ -197,11 +253,19 @@ int run(int argc, char** argv) {
   bag.close();
   const double wall_seconds = seconds(Clock::now() - start);
   if (!quiet) std::fprintf(stderr, "\n");
-  if (processed == 0)
-    throw InputError(bag_path, received == 0 ? "no scans on topic " + scan_topic
-                               : without_returns == received ? "no scan has a valid range"
-                                                             : "no scan has odometry (" + odom_frame + " -> " +
-                                                                   base_frame + " in /tf) at its stamp: " + last_tf_error);
+  if (processed == 0) {
+    const std::string odometry_source = odom_topic.empty() ? "in /tf; a bag with odometry only as nav_msgs/Odometry "
+                                                             "needs --odom-topic"
+                                                           : "from " + odom_topic;
+    throw InputError(bag_path,
+                     received == 0                    ? "no scans on topic " + scan_topic
+                     : without_returns == received    ? "no scan has a valid range"
+                     : without_mount + without_returns == received
+                         ? "no laser mount: no transform from " + base_frame + " to the scans' frame (usually on " +
+                               "/tf_static): " + last_mount_error
+                         : "no scan has odometry (" + odom_frame + " -> " + base_frame + " " + odometry_source +
+                               ") at its stamp: " + last_tf_error);
+  }
 
   const hidden_rooms::common::OccupancyGrid map = mapper.map();
   const std::string yaml = hidden_rooms::common::saveMap(map, prefix);

@@ -10,6 +10,9 @@
 #include <gtest/gtest.h>
 #include <nav_msgs/Odometry.h>
 #include <rosbag/bag.h>
+#include <rosbag/view.h>
+#include <sensor_msgs/LaserScan.h>
+#include <tf2_msgs/TFMessage.h>
 
 #include "test_util.h"
 
@@ -84,6 +87,82 @@ TEST_F(MapFromBag, SameBagAndSeedGiveTheSameMapAlsoAfterASigkill) {
             testing::readFile(killed_dir + "/s2.yaml").substr(testing::readFile(killed_dir + "/s2.yaml").find("resolution")));
 }
 
+// How other robots write bags, as variants of the recorded one.
+struct BagVariant {
+  bool leading_slashes = false;  // "/base_scan", "/odom", frame ids "/base_link", as older bags have them
+  bool odometry_in_tf = true;    // false: odometry only as nav_msgs/Odometry on "odom"
+  bool laser_mount = true;       // false: no /tf_static
+};
+
+void writeVariant(const std::string& from, const std::string& to, const BagVariant& variant) {
+  rosbag::Bag in(from, rosbag::bagmode::Read);
+  rosbag::Bag out(to, rosbag::bagmode::Write);
+  const auto name = [&](const std::string& n) { return variant.leading_slashes && n[0] != '/' ? "/" + n : n; };
+  for (const rosbag::MessageInstance& message : rosbag::View(in)) {
+    const std::string topic = name(message.getTopic());
+    if (auto tf = message.instantiate<tf2_msgs::TFMessage>()) {
+      if (message.getTopic() == "/tf_static" && !variant.laser_mount) continue;
+      if (message.getTopic() == "/tf" && !variant.odometry_in_tf) continue;
+      for (geometry_msgs::TransformStamped& transform : tf->transforms) {
+        transform.header.frame_id = name(transform.header.frame_id);
+        transform.child_frame_id = name(transform.child_frame_id);
+      }
+      out.write(topic, message.getTime(), *tf);
+    } else if (auto scan = message.instantiate<sensor_msgs::LaserScan>()) {
+      scan->header.frame_id = name(scan->header.frame_id);
+      out.write(topic, message.getTime(), *scan);
+    } else if (auto odometry = message.instantiate<nav_msgs::Odometry>()) {
+      odometry->header.frame_id = name(odometry->header.frame_id);
+      odometry->child_frame_id = name(odometry->child_frame_id);
+      out.write(topic, message.getTime(), *odometry);
+    }
+  }
+}
+
+// Leading slashes on topics and frames change nothing; odometry only as nav_msgs/Odometry maps with --odom-topic and
+// without it names the option; a bag without the laser mount names the mount, not the odometry.
+TEST_F(MapFromBag, ReadsBagsAsOtherRobotsWriteThem) {
+  const std::string tool = MAP_FROM_BAG_BIN;
+  auto result = testing::runCommand(tool + " " + dir_ + "/run.bag --quiet --seed 3 --out " + dir_ + "/plain");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+
+  BagVariant slashes;
+  slashes.leading_slashes = true;
+  writeVariant(dir_ + "/run.bag", dir_ + "/slashes.bag", slashes);
+  result = testing::runCommand(tool + " " + dir_ + "/slashes.bag --quiet --seed 3 --out " + dir_ + "/slashes");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_EQ(figure(result.output, "scans"), 600);
+  EXPECT_EQ(testing::readFile(dir_ + "/slashes.pgm"), testing::readFile(dir_ + "/plain.pgm"));
+  result = testing::runCommand(tool + " " + dir_ + "/slashes.bag --quiet --seed 3 --scan-topic /base_scan --out " +
+                               dir_ + "/slashes2");
+  EXPECT_EQ(result.exit_code, 0) << result.output;
+
+  BagVariant odometry_topic;
+  odometry_topic.odometry_in_tf = false;
+  writeVariant(dir_ + "/run.bag", dir_ + "/odometry_topic.bag", odometry_topic);
+  result = testing::runCommand(tool + " " + dir_ + "/odometry_topic.bag --quiet --out " + dir_ + "/x");
+  EXPECT_EQ(result.exit_code, 2) << result.output;
+  EXPECT_NE(result.output.find("--odom-topic"), std::string::npos) << result.output;
+  result = testing::runCommand(tool + " " + dir_ + "/odometry_topic.bag --quiet --seed 3 --odom-topic odom --out " +
+                               dir_ + "/odometry_topic");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_EQ(figure(result.output, "scans"), 600);
+  EXPECT_EQ(testing::readFile(dir_ + "/odometry_topic.pgm"), testing::readFile(dir_ + "/plain.pgm"));
+  result = testing::runCommand(tool + " " + dir_ + "/odometry_topic.bag --quiet --odom-topic wheels --out " + dir_ +
+                               "/x");
+  EXPECT_EQ(result.exit_code, 2) << result.output;
+  EXPECT_NE(result.output.find("Odometry topics: base_pose_ground_truth, odom"), std::string::npos) << result.output;
+
+  BagVariant no_mount;
+  no_mount.laser_mount = false;
+  writeVariant(dir_ + "/run.bag", dir_ + "/no_mount.bag", no_mount);
+  result = testing::runCommand(tool + " " + dir_ + "/no_mount.bag --quiet --out " + dir_ + "/x");
+  EXPECT_EQ(result.exit_code, 2) << result.output;
+  EXPECT_NE(result.output.find("no laser mount"), std::string::npos) << result.output;
+  std::ifstream written(dir_ + "/x.yaml");
+  EXPECT_FALSE(written.good()) << "nothing is written on bad input";
+}
+
 TEST_F(MapFromBag, BadInputGivesAClearErrorAndExitCode2) {
   const std::string tool = MAP_FROM_BAG_BIN;
   auto result = testing::runCommand(tool + " " + dir_ + "/missing.bag --out " + dir_ + "/x");
@@ -107,6 +186,7 @@ TEST_F(MapFromBag, BadInputGivesAClearErrorAndExitCode2) {
 
   result = testing::runCommand(tool + " " + dir_ + "/run.bag --out " + dir_ + "/x --scan-topic nothing");
   EXPECT_EQ(result.exit_code, 2) << result.output;
+  EXPECT_NE(result.output.find("LaserScan topics: base_scan"), std::string::npos) << result.output;
   std::ifstream written(dir_ + "/x.yaml");
   EXPECT_FALSE(written.good()) << "nothing is written on bad input";
 }
