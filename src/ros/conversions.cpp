@@ -1,5 +1,6 @@
 #include "hidden_rooms/ros/conversions.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -283,6 +284,24 @@ common::Pose2 fromRos(const geometry_msgs::Transform& transform) {
   pose.position.y = transform.translation.y;
   pose.orientation = transform.rotation;
   return fromRos(pose);
+}
+
+LaserMount laserMountFromRos(const geometry_msgs::Transform& transform) {
+  const auto& q = transform.rotation;
+  LaserMount mount;
+  mount.pose = fromRos(transform);
+  mount.upside_down = 1.0 - 2.0 * (q.x * q.x + q.y * q.y) < 0.0;  // z component of the laser's z axis
+  return mount;
+}
+
+sensor_msgs::LaserScan uprightScan(const sensor_msgs::LaserScan& message, const LaserMount& mount) {
+  if (!mount.upside_down) return message;
+  sensor_msgs::LaserScan upright = message;
+  upright.angle_min = -message.angle_max;
+  upright.angle_max = -message.angle_min;
+  std::reverse(upright.ranges.begin(), upright.ranges.end());
+  std::reverse(upright.intensities.begin(), upright.intensities.end());
+  return upright;
 }
 
 geometry_msgs::PoseArray toRos(const std::vector<mapping::RbpfParticle>& particles, const std::string& frame_id,

@@ -85,9 +85,9 @@ void Explorer::onMap(const nav_msgs::OccupancyGrid::ConstPtr& map) {
 }
 
 void Explorer::onScan(const sensor_msgs::LaserScan::ConstPtr& scan) {
-  common::Pose2 sensor;
+  LaserMount mount;
   try {
-    sensor = fromRos(tf_buffer_.lookupTransform(options_.base_frame, scan->header.frame_id, ros::Time(0)).transform);
+    mount = laserMountFromRos(tf_buffer_.lookupTransform(options_.base_frame, scan->header.frame_id, ros::Time(0)).transform);
   } catch (const tf2::TransformException& error) {
     ROS_WARN_THROTTLE(5.0, "explorer: no transform %s -> %s (%s); scan ignored", options_.base_frame.c_str(),
                       scan->header.frame_id.c_str(), error.what());
@@ -95,7 +95,7 @@ void Explorer::onScan(const sensor_msgs::LaserScan::ConstPtr& scan) {
   }
   try {
     int skipped = 0;
-    scan_points_ = exploration::obstaclePoints(fromRos(*scan, sensor), &skipped);
+    scan_points_ = exploration::obstaclePoints(fromRos(uprightScan(*scan, mount), mount.pose), &skipped);
     scan_remembered_ = false;
     int non_finite = 0;
     for (float range : scan->ranges) non_finite += !std::isfinite(range);

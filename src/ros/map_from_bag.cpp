@@ -181,9 +181,9 @@ int run(int argc, char** argv) {
       return;
     }
     const std::string laser_frame = withoutLeadingSlash(scan.header.frame_id);
-    Pose2 sensor;
+    hidden_rooms::LaserMount mount;
     try {
-      sensor = hidden_rooms::fromRos(tf_buffer.lookupTransform(base_frame, laser_frame, ros::Time(0)).transform);
+      mount = hidden_rooms::laserMountFromRos(tf_buffer.lookupTransform(base_frame, laser_frame, ros::Time(0)).transform);
     } catch (const tf2::TransformException& error) {
       ++dropped;
       ++without_mount;
@@ -193,12 +193,13 @@ int run(int argc, char** argv) {
     try {
       const Pose2 odometry =
           hidden_rooms::fromRos(tf_buffer.lookupTransform(odom_frame, base_frame, scan.header.stamp).transform);
-      const bool inserted = mapper.addScan(odometry, hidden_rooms::toMrptScan(scan, sensor));
+      const sensor_msgs::LaserScan upright = hidden_rooms::uprightScan(scan, mount);
+      const bool inserted = mapper.addScan(odometry, hidden_rooms::toMrptScan(upright, mount.pose));
       ++processed;
       if (!environment_path.empty()) {
         scan_times.push_back(scan.header.stamp.toSec());
         estimate.push_back(mapper.pose());
-        if (inserted) inserted_scans.emplace_back(scan.header.stamp.toSec(), hidden_rooms::fromRos(scan, sensor));
+        if (inserted) inserted_scans.emplace_back(scan.header.stamp.toSec(), hidden_rooms::fromRos(upright, mount.pose));
       }
     } catch (const tf2::TransformException& error) {
       ++dropped;

@@ -125,17 +125,18 @@ void Mapper::processPending() {
 }
 
 bool Mapper::process(const sensor_msgs::LaserScan& scan) {
-  common::Pose2 odometry, sensor;
+  common::Pose2 odometry;
+  LaserMount mount;
   try {
     odometry = fromRos(tf_buffer_.lookupTransform(options_.odom_frame, options_.base_frame, scan.header.stamp).transform);
-    sensor = fromRos(tf_buffer_.lookupTransform(options_.base_frame, scan.header.frame_id, ros::Time(0)).transform);
+    mount = laserMountFromRos(tf_buffer_.lookupTransform(options_.base_frame, scan.header.frame_id, ros::Time(0)).transform);
   } catch (const tf2::TransformException& error) {
     ROS_WARN_THROTTLE(5.0, "mapper: %s; scan dropped", error.what());
     ++dropped_;
     return false;
   }
   try {
-    mapper_->addScan(odometry, toMrptScan(scan, sensor));
+    mapper_->addScan(odometry, toMrptScan(uprightScan(scan, mount), mount.pose));
   } catch (const common::InputError& error) {
     ROS_WARN_THROTTLE(5.0, "mapper: bad scan: %s", error.what());
     ++dropped_;

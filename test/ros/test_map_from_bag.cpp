@@ -1,5 +1,6 @@
 // map_from_bag on a short bag recorded from the core simulation (record_simulation_bag): the map against the
 // rendered ground truth, the same map for the same bag and seed, and clear errors on bad input.
+#include <algorithm>
 #include <chrono>
 #include <fstream>
 #include <sstream>
@@ -92,6 +93,7 @@ struct BagVariant {
   bool leading_slashes = false;  // "/base_scan", "/odom", frame ids "/base_link", as older bags have them
   bool odometry_in_tf = true;    // false: odometry only as nav_msgs/Odometry on "odom"
   bool laser_mount = true;       // false: no /tf_static
+  bool upside_down = false;      // the laser hangs upside down: mount rolled by pi, beams in the mirrored order
 };
 
 void writeVariant(const std::string& from, const std::string& to, const BagVariant& variant) {
@@ -104,12 +106,27 @@ void writeVariant(const std::string& from, const std::string& to, const BagVaria
       if (message.getTopic() == "/tf_static" && !variant.laser_mount) continue;
       if (message.getTopic() == "/tf" && !variant.odometry_in_tf) continue;
       for (geometry_msgs::TransformStamped& transform : tf->transforms) {
+        if (message.getTopic() == "/tf_static" && variant.upside_down) {  // the mount times a roll by pi
+          geometry_msgs::Quaternion& q = transform.transform.rotation;
+          const geometry_msgs::Quaternion mount = q;
+          q.w = -mount.x;
+          q.x = mount.w;
+          q.y = mount.z;
+          q.z = -mount.y;
+        }
         transform.header.frame_id = name(transform.header.frame_id);
         transform.child_frame_id = name(transform.child_frame_id);
       }
       out.write(topic, message.getTime(), *tf);
     } else if (auto scan = message.instantiate<sensor_msgs::LaserScan>()) {
       scan->header.frame_id = name(scan->header.frame_id);
+      if (variant.upside_down) {  // the same beams, seen from a laser whose angles run the other way
+        const float angle_min = scan->angle_min;
+        scan->angle_min = -scan->angle_max;
+        scan->angle_max = -angle_min;
+        std::reverse(scan->ranges.begin(), scan->ranges.end());
+        std::reverse(scan->intensities.begin(), scan->intensities.end());
+      }
       out.write(topic, message.getTime(), *scan);
     } else if (auto odometry = message.instantiate<nav_msgs::Odometry>()) {
       odometry->header.frame_id = name(odometry->header.frame_id);
@@ -119,7 +136,7 @@ void writeVariant(const std::string& from, const std::string& to, const BagVaria
   }
 }
 
-// Leading slashes on topics and frames change nothing; odometry only as nav_msgs/Odometry maps with --odom-topic and
+// Leading slashes on topics and frames and a laser hanging upside down change nothing; odometry only as nav_msgs/Odometry maps with --odom-topic and
 // without it names the option; a bag without the laser mount names the mount, not the odometry.
 TEST_F(MapFromBag, ReadsBagsAsOtherRobotsWriteThem) {
   const std::string tool = MAP_FROM_BAG_BIN;
@@ -152,6 +169,14 @@ TEST_F(MapFromBag, ReadsBagsAsOtherRobotsWriteThem) {
                                "/x");
   EXPECT_EQ(result.exit_code, 2) << result.output;
   EXPECT_NE(result.output.find("Odometry topics: base_pose_ground_truth, odom"), std::string::npos) << result.output;
+
+  BagVariant upside_down;  // mapped as it is, mirrored without the mount's roll
+  upside_down.upside_down = true;
+  writeVariant(dir_ + "/run.bag", dir_ + "/upside_down.bag", upside_down);
+  result = testing::runCommand(tool + " " + dir_ + "/upside_down.bag --quiet --seed 3 --out " + dir_ + "/upside_down");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_EQ(figure(result.output, "scans"), 600);
+  EXPECT_EQ(testing::readFile(dir_ + "/upside_down.pgm"), testing::readFile(dir_ + "/plain.pgm"));
 
   BagVariant no_mount;
   no_mount.laser_mount = false;

@@ -6,6 +6,7 @@
 #include <mrpt/poses/CPose3D.h>
 
 #include "hidden_rooms/common/input_error.h"
+#include "hidden_rooms/ros/conversions.h"
 #include "hidden_rooms/ros/mrpt_scan.h"
 
 namespace hidden_rooms {
@@ -86,6 +87,38 @@ TEST(MrptScan, NanInfinityAndOutOfRangeBeamsAreInvalid) {
   // A scan of nothing but such beams has no valid range (the mapper ignores it).
   for (size_t i = 0; i < message.ranges.size(); ++i) message.ranges[i] = message.ranges[10 + i % 5];
   EXPECT_EQ(countValidRanges(message), 0u);
+}
+
+// A laser hanging upside down (its mount rolled by pi, here also yawed by 90 degrees): its beams sweep clockwise seen
+// from above, so the upright scan negates and reverses them, and the mount keeps its yaw.
+TEST(MrptScan, AnUpsideDownLaserIsTurnedUpright) {
+  geometry_msgs::Transform transform;
+  transform.translation.x = 0.2;
+  const double half = M_PI / 4;  // yaw 90 degrees times roll 180 degrees
+  transform.rotation.w = 0.0;
+  transform.rotation.x = std::cos(half);
+  transform.rotation.y = std::sin(half);
+  transform.rotation.z = 0.0;
+  const LaserMount mount = laserMountFromRos(transform);
+  EXPECT_TRUE(mount.upside_down);
+  EXPECT_NEAR(mount.pose.yaw, M_PI / 2, 1e-9);
+  EXPECT_NEAR(mount.pose.x, 0.2, 1e-12);
+  sensor_msgs::LaserScan scan;
+  scan.angle_min = -0.5f;
+  scan.angle_max = 1.0f;
+  scan.angle_increment = 0.5f;
+  scan.ranges = {1.0f, 2.0f, 3.0f, 4.0f};
+  const sensor_msgs::LaserScan upright = uprightScan(scan, mount);
+  EXPECT_FLOAT_EQ(upright.angle_min, -1.0f);
+  EXPECT_FLOAT_EQ(upright.angle_max, 0.5f);
+  EXPECT_EQ(upright.ranges, (std::vector<float>{4.0f, 3.0f, 2.0f, 1.0f}));
+  // Right way up: unchanged.
+  transform.rotation.w = std::cos(half);
+  transform.rotation.x = 0.0;
+  transform.rotation.y = 0.0;
+  transform.rotation.z = std::sin(half);
+  EXPECT_FALSE(laserMountFromRos(transform).upside_down);
+  EXPECT_EQ(uprightScan(scan, laserMountFromRos(transform)).ranges, scan.ranges);
 }
 
 TEST(MrptScan, BadMessagesGiveClearErrors) {

@@ -76,6 +76,17 @@ common::Pose2 fromRos(const geometry_msgs::Pose& pose);
 common::RangeScan fromRos(const sensor_msgs::LaserScan& message, const common::Pose2& sensor_pose);
 // The planar part of a transform (translation x, y and the yaw of its rotation).
 common::Pose2 fromRos(const geometry_msgs::Transform& transform);
+// A laser's mount, from the transform base frame -> scan frame: the planar pose of the scan's frame, and whether the
+// laser hangs upside down (its z axis points down, e.g. rolled by pi), so that its beams sweep clockwise seen from
+// above.
+struct LaserMount {
+  common::Pose2 pose;
+  bool upside_down = false;
+};
+LaserMount laserMountFromRos(const geometry_msgs::Transform& transform);
+// The scan as the same laser mounted the right way up at `mount.pose` gives it: for an upside-down mount the beams
+// in reverse order, their angles negated (angle_min = -angle_max); otherwise the message unchanged.
+sensor_msgs::LaserScan uprightScan(const sensor_msgs::LaserScan& message, const LaserMount& mount);
 // The particles' poses in `frame_id` (weights are not part of the message).
 geometry_msgs::PoseArray toRos(const std::vector<mapping::RbpfParticle>& particles, const std::string& frame_id,
                                const ros::Time& stamp);
