@@ -656,8 +656,10 @@ std::vector<cv::Mat1b> roomMasks(const Frame& f, const std::vector<DoorFrame>& d
   }
   for (size_t i = 0; i < count; ++i) {
     if (!doors[i].ok || masks[i].empty()) continue;
-    // A room's pixels lie in its rectangle: the work below stays there.
+    // A room's pixels lie in its rectangle: the work below stays there (an empty rectangle, e.g. of two doors at
+    // one place, leaves an empty room).
     const cv::Rect rect = rects[i] & cv::Rect(0, 0, work_size.width, work_size.height);
+    if (rect.empty()) continue;
     cv::Mat1b in_rect = masks[i](rect);
     in_rect.setTo(0, owner(rect) != static_cast<short>(i));
     // Keep what is connected to the door.

@@ -362,6 +362,26 @@ TEST(DefaultPredictor, LeavesTheUnseenWallsOutOfTheRooms) {
   EXPECT_GT(with_margin, without + 0.05);
 }
 
+// Doors that share one place (their rectangles split the shared wall down to nothing) or crowd at the map's corner
+// once failed the whole prediction with an OpenCV error; now each door gets its own room or its own problem.
+TEST(DefaultPredictor, DoorsAtOnePlaceOrCrowdedAtTheEdgeArePredictedOneByOne) {
+  cv::Mat1b states(120, 400, static_cast<uint8_t>(2));
+  states(cv::Rect(8, 80, 384, 32)).setTo(1);
+  for (int x = 8; x + 40 <= 392; x += 48) states(cv::Rect(x, 8, 40, 64)).setTo(1);
+  states(cv::Rect(144, 0, 56, 78)).setTo(0);  // the hidden room of the doors
+  cv::Mat1w truth = cv::Mat1w::zeros(states.size());
+  truth(cv::Rect(152, 8, 40, 64)).setTo(1);
+  for (const std::vector<cv::Point2d>& doors :
+       {std::vector<cv::Point2d>{{172, 77}, {172, 77}}, std::vector<cv::Point2d>{{172, 77}, {1, 1}, {2, 1}, {3, 2}}}) {
+    const Synthetic s = syntheticFromStates(states, truth, doors);
+    PredictionResult result;
+    ASSERT_NO_THROW(result = makeRoomPredictor("default")->predict(s.request));
+    ASSERT_EQ(result.rooms.size(), doors.size());
+    EXPECT_TRUE(result.rooms[0].placed) << result.rooms[0].problem;
+    for (const RoomPrediction& room : result.rooms) EXPECT_TRUE(room.placed || !room.problem.empty());
+  }
+}
+
 TEST(DefaultPredictor, ClipsRoomsToTheKnownOutlineBesideThem) {
   cv::Mat1b known = cv::Mat1b::zeros(100, 100);
   known(cv::Rect(60, 20, 30, 60)).setTo(255);  // an explored room beside the hidden one, rows 20..79
