@@ -1,5 +1,6 @@
 #include "hidden_rooms/common/command_line.h"
 
+#include <cstdio>
 #include <exception>
 #include <iostream>
 
@@ -9,14 +10,33 @@ namespace hidden_rooms::common {
 
 namespace po = boost::program_options;
 
+namespace {
+
+// A message on one line: control characters (a newline quoted from a damaged file, ...) shown as \xNN.
+std::string oneLine(const std::string& message) {
+  std::string line;
+  for (const char c : message) {
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
+      char escaped[8];
+      std::snprintf(escaped, sizeof(escaped), "\\x%02x", static_cast<unsigned char>(c));
+      line += escaped;
+    } else {
+      line += c;
+    }
+  }
+  return line;
+}
+
+}  // namespace
+
 int runTool(const std::string& tool_name, const std::function<int()>& body) {
   try {
     return body();
   } catch (const InputError& error) {
-    std::cerr << tool_name << ": error: " << error.what() << std::endl;
+    std::cerr << tool_name << ": error: " << oneLine(error.what()) << std::endl;
     return kExitBadInput;
   } catch (const std::exception& error) {
-    std::cerr << tool_name << ": internal error: " << error.what() << std::endl;
+    std::cerr << tool_name << ": internal error: " << oneLine(error.what()) << std::endl;
     return kExitFailure;
   }
 }

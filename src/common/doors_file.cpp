@@ -7,6 +7,7 @@
 
 #include "hidden_rooms/common/file_io.h"
 #include "hidden_rooms/common/input_error.h"
+#include "hidden_rooms/common/input_limits.h"
 
 namespace hidden_rooms::common {
 
@@ -75,6 +76,7 @@ DoorsFile parseDoors(const std::string& yaml_text, const std::string& source) {
   if (!doors) throw InputError(source, "missing 'doors' list");
   if (doors.IsNull()) return file;  // "doors:" with nothing: no closed door
   if (!doors.IsSequence()) throw InputError(source, "'doors' must be a list");
+  checkLimit(source, "the number of doors", static_cast<double>(doors.size()), kMaxDoors);
   std::set<int> ids;
   for (size_t i = 0; i < doors.size(); ++i) {
     MapDoor door = readDoor(doors[i], i, source);

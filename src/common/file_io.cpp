@@ -1,9 +1,12 @@
 #include "hidden_rooms/common/file_io.h"
 
+#include <fcntl.h>
 #include <signal.h>
+#include <sys/file.h>
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -34,13 +37,10 @@ namespace {
 
 constexpr const char* kTemporarySuffix = ".partial";
 
-// Removes the temporaries of `path` (PATH.partialPID) whose writer no longer runs: a writer killed during the
-// write leaves one behind.
-void removeStaleTemporaries(const std::string& path) {
+// Removes the entries of `folder` named PREFIX<PID> (files or folders) whose writer no longer runs: a writer killed
+// during its write leaves one behind.
+void removeStaleTemporaries(const std::filesystem::path& folder, const std::string& prefix) {
   namespace fs = std::filesystem;
-  const fs::path target(path);
-  const fs::path folder = target.has_parent_path() ? target.parent_path() : fs::path(".");
-  const std::string prefix = target.filename().string() + kTemporarySuffix;
   std::error_code error;
   for (fs::directory_iterator entry(folder, error), end; !error && entry != end; entry.increment(error)) {
     const std::string name = entry->path().filename().string();
@@ -50,7 +50,7 @@ void removeStaleTemporaries(const std::string& path) {
     const pid_t writer = static_cast<pid_t>(std::stol(digits));
     if (writer > 0 && kill(writer, 0) == -1 && errno == ESRCH) {
       std::error_code ignored;
-      fs::remove(entry->path(), ignored);
+      fs::remove_all(entry->path(), ignored);
     }
   }
 }
@@ -58,7 +58,10 @@ void removeStaleTemporaries(const std::string& path) {
 }  // namespace
 
 void writeAtomically(const std::string& path, const std::function<void(const std::string& temporary_path)>& write) {
-  removeStaleTemporaries(path);
+  const std::filesystem::path target(path);
+  if (target.has_parent_path()) createOutputDirectory(target.parent_path().string());
+  removeStaleTemporaries(target.has_parent_path() ? target.parent_path() : std::filesystem::path("."),
+                         target.filename().string() + kTemporarySuffix);
   // Unique per process, in the target's folder (a rename within one file system is atomic).
   const std::string temporary = path + kTemporarySuffix + std::to_string(getpid());
   std::error_code ignored;
@@ -90,6 +93,78 @@ void createOutputDirectory(const std::string& path) {
   std::filesystem::create_directories(path, error);
   if (error || !std::filesystem::is_directory(path))
     throw InputError(path, "cannot create output folder" + (error ? ": " + error.message() : std::string()));
+}
+
+namespace {
+
+constexpr const char* kStagingPrefix = ".partial";
+
+}  // namespace
+
+OutputFolder::OutputFolder(const std::string& out, const std::vector<std::string>& inputs) : out_(out) {
+  namespace fs = std::filesystem;
+  created_ = !fs::exists(out);
+  createOutputDirectory(out);
+  const fs::path folder(out);
+  lock_fd_ = open(out.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (lock_fd_ < 0) throw InputError(out, std::string("cannot open the output folder: ") + std::strerror(errno));
+  if (flock(lock_fd_, LOCK_EX | LOCK_NB) != 0) {
+    close(lock_fd_);
+    throw InputError(out, "another run is writing into this output folder (it holds the folder's lock)");
+  }
+  removeStaleTemporaries(folder, kStagingPrefix);
+  staging_ = (folder / (kStagingPrefix + std::to_string(getpid()))).string();
+  std::error_code ignored;
+  fs::remove_all(staging_, ignored);
+  createOutputDirectory(staging_);
+  for (const std::string& input : inputs) {
+    if (input.empty()) continue;  // an optional input not given
+    std::error_code error;
+    const fs::path canonical = fs::weakly_canonical(input, error);
+    if (!error) inputs_.push_back(canonical.string());
+  }
+}
+
+OutputFolder::~OutputFolder() {
+  std::error_code ignored;
+  if (!staging_.empty()) std::filesystem::remove_all(staging_, ignored);
+  if (created_ && !committed_) std::filesystem::remove(out_, ignored);  // only when empty
+  if (lock_fd_ >= 0) close(lock_fd_);  // releases the lock
+}
+
+std::string OutputFolder::file(const std::string& name) const {
+  namespace fs = std::filesystem;
+  std::error_code error;
+  const fs::path final_path = fs::weakly_canonical(fs::path(out_) / name, error);
+  for (const std::string& input : inputs_)
+    if (!error && final_path.string() == input)
+      throw InputError(out_, "the output " + name + " would replace the input " + input +
+                                 ": choose an --out that does not hold the inputs");
+  return (fs::path(staging_) / name).string();
+}
+
+std::string OutputFolder::mapPrefix(const std::string& stem, const std::string& image_extension) const {
+  file(stem + image_extension);
+  file(stem + ".yaml");
+  return file(stem);
+}
+
+void OutputFolder::commit() {
+  namespace fs = std::filesystem;
+  std::vector<fs::path> staged;
+  std::error_code error;
+  for (fs::directory_iterator entry(staging_, error), end; !error && entry != end; entry.increment(error))
+    staged.push_back(entry->path());
+  if (error) throw InputError(out_, "cannot list the staged outputs: " + error.message());
+  for (const fs::path& file : staged)
+    if (fs::is_directory(fs::path(out_) / file.filename()))
+      throw InputError((fs::path(out_) / file.filename()).string(), "is a folder: the output of that name cannot "
+                                                                     "replace it (nothing was written)");
+  for (const fs::path& file : staged) {
+    fs::rename(file, fs::path(out_) / file.filename(), error);
+    if (error) throw InputError((fs::path(out_) / file.filename()).string(), "cannot be written: " + error.message());
+  }
+  committed_ = true;
 }
 
 }  // namespace hidden_rooms::common

@@ -14,6 +14,7 @@
 
 #include "hidden_rooms/common/file_io.h"
 #include "hidden_rooms/common/input_error.h"
+#include "hidden_rooms/common/input_limits.h"
 
 namespace hidden_rooms::common {
 
@@ -31,6 +32,12 @@ struct PngImage {
   ~PngImage() { png_image_free(&image); }
 };
 
+// Refuses an image whose header declares more pixels than kMaxMapCells, before its pixels are allocated.
+void checkImageSize(const std::string& path, double width, double height) {
+  checkLimit(path, "the image's size (" + formatNumber(width) + " x " + formatNumber(height) + " pixels)",
+             width * height, kMaxMapCells, " pixels");
+}
+
 cv::Mat readPng(const std::string& path) {
   PngImage png;
   if (!png_image_begin_read_from_file(&png.image, path.c_str()))
@@ -41,6 +48,7 @@ cv::Mat readPng(const std::string& path) {
   if (format & PNG_FORMAT_FLAG_COLOR) format |= PNG_FORMAT_FLAG_BGR;
   png.image.format = format;
   if (png.image.width == 0 || png.image.height == 0) throw InputError(path, "image is empty");
+  checkImageSize(path, png.image.width, png.image.height);
   const int channels = PNG_IMAGE_SAMPLE_CHANNELS(format);
   const bool sixteen = (format & PNG_FORMAT_FLAG_LINEAR) != 0;
   cv::Mat image(static_cast<int>(png.image.height), static_cast<int>(png.image.width),
@@ -87,6 +95,7 @@ cv::Mat readNetpbm(const std::string& path, const std::string& data) {
   const int width = headerNumber(data, &pos, path, "width", 1 << 16);
   const int height = headerNumber(data, &pos, path, "height", 1 << 16);
   const int max_value = headerNumber(data, &pos, path, "maxval", 65535);
+  checkImageSize(path, width, height);
   const bool sixteen = max_value > 255;
   const size_t samples = static_cast<size_t>(width) * height * channels;
   if (samples > data.size() - pos) throw InputError(path, "Netpbm pixel data is truncated");
@@ -163,6 +172,7 @@ bool writePngRows(std::FILE* file, const PngRows& image, char* error) {
 }  // namespace
 
 cv::Mat readImage(const std::string& path) {
+  if (std::filesystem::is_directory(path)) throw InputError(path, "is a folder, not an image file");
   if (!std::filesystem::is_regular_file(path)) throw InputError(path, "image file does not exist");
   std::ifstream file(path, std::ios::binary);
   if (!file) throw InputError(path, "cannot open image file");

@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 
@@ -61,7 +62,11 @@ MapMetadata readMetadata(const std::string& yaml_path) {
   if (std::abs(metadata.origin_yaw) > 1e-9)
     throw InputError(yaml_path, "origin yaw " + std::to_string(metadata.origin_yaw) + " is not supported (only 0)");
 
-  metadata.negate = root["negate"] ? readScalar<int>(root, "negate", yaml_path) != 0 : false;
+  if (root["negate"]) {
+    const int negate = readScalar<int>(root, "negate", yaml_path);
+    if (negate != 0 && negate != 1) throw InputError(yaml_path, "negate is " + std::to_string(negate) + " (0 or 1)");
+    metadata.negate = negate == 1;
+  }
   metadata.occupied_thresh = readFinite(root, "occupied_thresh", yaml_path);
   metadata.free_thresh = readFinite(root, "free_thresh", yaml_path);
   if (!(metadata.free_thresh >= 0.0 && metadata.free_thresh < metadata.occupied_thresh &&
@@ -77,6 +82,11 @@ MapMetadata readMetadata(const std::string& yaml_path) {
   return metadata;
 }
 
+std::filesystem::path imagePathOf(const std::string& yaml_path, const MapMetadata& metadata) {
+  const std::filesystem::path image_path(metadata.image);
+  return image_path.is_relative() ? std::filesystem::path(yaml_path).parent_path() / image_path : image_path;
+}
+
 }  // namespace
 
 Point2 OccupancyGrid::cellCentre(int col, int row) const {
@@ -90,12 +100,10 @@ Point2 OccupancyGrid::toImage(const Point2& point) const {
 
 bool OccupancyGrid::cellOf(const Point2& point, int* col, int* row) const {
   const Point2 image = toImage(point);
-  if (!image.allFinite()) return false;
-  const int c = static_cast<int>(std::floor(image.x()));
-  const int r = static_cast<int>(std::floor(image.y()));
-  if (c < 0 || r < 0 || c >= width() || r >= height()) return false;
-  *col = c;
-  *row = r;
+  // The map's closed extent (NaN fails every comparison): a point on the far edges belongs to the edge cells.
+  if (!(image.x() >= 0.0 && image.x() <= width() && image.y() >= 0.0 && image.y() <= height())) return false;
+  *col = std::min(static_cast<int>(image.x()), width() - 1);
+  *row = std::min(static_cast<int>(image.y()), height() - 1);
   return true;
 }
 
@@ -154,10 +162,13 @@ OccupancyGrid gridFromImage(const cv::Mat& image, const MapMetadata& metadata) {
   return grid;
 }
 
+std::string mapImagePath(const std::string& yaml_path) {
+  return imagePathOf(yaml_path, readMetadata(yaml_path)).string();
+}
+
 OccupancyGrid loadMap(const std::string& yaml_path) {
   const MapMetadata metadata = readMetadata(yaml_path);
-  std::filesystem::path image_path(metadata.image);
-  if (image_path.is_relative()) image_path = std::filesystem::path(yaml_path).parent_path() / image_path;
+  const std::filesystem::path image_path = imagePathOf(yaml_path, metadata);
   if (!std::filesystem::is_regular_file(image_path))
     throw InputError(yaml_path, "map image '" + image_path.string() + "' does not exist");
   cv::Mat image;

@@ -53,6 +53,14 @@ common::DoorsFile translateDoors(const world::Environment& environment, const st
                                  const std::vector<common::TimedPose>& truth,
                                  const std::vector<common::TimedPose>& estimate, double door_width,
                                  bool with_map_from_world) {
+  if (truth.empty() || estimate.empty()) throw common::InputError("door translation", "a trajectory is empty");
+  if (estimate.back().time < truth.front().time || estimate.front().time > truth.back().time)
+    throw common::InputError("door translation",
+                             "the true and estimated poses never overlap in time (true " +
+                                 common::formatNumber(truth.front().time) + " .. " +
+                                 common::formatNumber(truth.back().time) + " s, estimated " +
+                                 common::formatNumber(estimate.front().time) + " .. " +
+                                 common::formatNumber(estimate.back().time) + " s): the logs are not of one run");
   common::DoorsFile doors;
   doors.frame = "map";
   for (int index : door_indices) {

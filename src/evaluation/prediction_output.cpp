@@ -2,7 +2,6 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include <filesystem>
 #include <iomanip>
 #include <ostream>
 
@@ -61,20 +60,18 @@ void writeMetrics(const prediction::PredictionRequest& request, const RoomScores
 
 PredictionOutputs writePredictionOutputs(const prediction::PredictionRequest& request,
                                          const prediction::PredictionResult& result, const std::string& method,
-                                         const std::string& out_dir, const cv::Mat& true_labels) {
-  common::createOutputDirectory(out_dir);
-  const std::filesystem::path out(out_dir);
+                                         common::OutputFolder* out, const cv::Mat& true_labels) {
   PredictionOutputs outputs;
   outputs.labels = prediction::roomLabels(request.map, request.doors, result.rooms);
-  common::saveLabelImage(outputs.labels, (out / "rooms.png").string());
-  writeRoomsYaml(request, result, method, (out / "rooms.yaml").string());
-  common::saveMap(prediction::insertRooms(request.map, request.doors, result.rooms), (out / "map").string());
-  common::writeImage((out / "overlay.png").string(),
-                     prediction::renderPredictionOverlay(request.map, outputs.labels, true_labels));
-  if (!true_labels.empty()) {
+  if (!true_labels.empty())
     outputs.scores = scoreRooms(outputs.labels, true_labels, static_cast<int>(request.doors.doors.size()));
-    writeMetrics(request, *outputs.scores, (out / "metrics.yaml").string());
-  }
+  common::saveLabelImage(outputs.labels, out->file("rooms.png"));
+  writeRoomsYaml(request, result, method, out->file("rooms.yaml"));
+  common::saveMap(prediction::insertRooms(request.map, request.doors, result.rooms), out->mapPrefix("map"));
+  common::writeImage(out->file("overlay.png"),
+                     prediction::renderPredictionOverlay(request.map, outputs.labels, true_labels));
+  if (outputs.scores) writeMetrics(request, *outputs.scores, out->file("metrics.yaml"));
+  out->commit();
   return outputs;
 }
 
@@ -85,6 +82,9 @@ cv::Mat loadTrueRooms(const std::string& path, const common::OccupancyGrid& map)
   } catch (const common::InputError& error) {
     throw common::InputError(path, "cannot read the true rooms image: " + error.problem());
   }
+  if (truth.channels() != 1 || (truth.depth() != CV_8U && truth.depth() != CV_16U))
+    throw common::InputError(path, "true rooms image has " + std::to_string(truth.channels()) +
+                                       " channels or a depth other than 8 or 16 bits: a label image is grey");
   if (truth.size() != map.cells.size())
     throw common::InputError(path, "true rooms image is " + std::to_string(truth.cols) + "x" +
                                        std::to_string(truth.rows) + ", the map " + std::to_string(map.width()) + "x" +

@@ -9,7 +9,6 @@ case to DIR/results.csv as soon as it is done, and resumes from the rows already
 
 `scripts/batch_analysis` is the command line (see `main`).
 """
-import argparse
 import concurrent.futures
 import csv
 import fcntl
@@ -17,18 +16,21 @@ import io
 import json
 import os
 import random
+import re
+import shutil
 import subprocess
 import sys
 import tempfile
 import threading
 import time
 
-from hidden_rooms.package_tools import ToolError, find_binary, tool_error
+from hidden_rooms.package_tools import ArgumentParser, ToolError, find_binary, tool_error
 
 TOOL_NAME = "batch_cases"
 RESULTS_NAME = "results.csv"
 SETTINGS_NAME = "batch_settings.json"
 LOCK_NAME = ".batch_analysis.lock"
+TASK_FOLDER_PREFIX = "batch_task_"
 ALL_METHODS = ["default", "thesis", "unstructured", "structured", "skewnormal"]
 STDERR_EXCERPT_CHARS = 2000
 
@@ -156,13 +158,28 @@ def to_row(task, case):
     return row
 
 
+def remove_stale_task_folders():
+    """Removes the task folders (TMP/batch_task_PID_*) of processes that no longer run: a SIGKILL leaves them."""
+    pattern = re.compile(r"^%s(\d+)_" % TASK_FOLDER_PREFIX)
+    for name in os.listdir(tempfile.gettempdir()):
+        match = pattern.match(name)
+        if not match:
+            continue
+        try:
+            os.kill(int(match.group(1)), 0)
+        except ProcessLookupError:
+            shutil.rmtree(os.path.join(tempfile.gettempdir(), name), ignore_errors=True)
+        except (PermissionError, OverflowError):
+            pass  # another user's process, or no process id
+
+
 def run_task(task, on_row=None):
     """Runs batch_cases on the task's cases; returns the rows (also passed to on_row one by one as they come).
 
     Runs wherever it is called: in a local thread, or on a Dask worker (which needs only the package)."""
     binary = find_binary(TOOL_NAME, task.binary)
     rows = []
-    with tempfile.TemporaryDirectory(prefix="batch_task_") as folder:
+    with tempfile.TemporaryDirectory(prefix="%s%d_" % (TASK_FOLDER_PREFIX, os.getpid())) as folder:
         env_path = os.path.join(folder, task.environment_name.replace("/", "_") + ".xml")
         with open(env_path, "wb") as stream:
             stream.write(task.xml)
@@ -330,7 +347,7 @@ def run_dask(tasks, scheduler, on_row):
 
 
 def parse_arguments(argv):
-    parser = argparse.ArgumentParser(
+    parser = ArgumentParser(
         prog="batch_analysis",
         description="The thesis's batch analysis (docs/method.md#batch-analysis): per environment and batch, close "
                     "the closable doors one at a time at random, cumulatively, erase the rooms behind them, run every method "
@@ -413,6 +430,7 @@ def summarize(rows, methods, out):
 
 def main(argv=None):
     args = parse_arguments(sys.argv[1:] if argv is None else argv)
+    remove_stale_task_folders()
     try:
         binary = find_binary(TOOL_NAME, args.binary)
         available = known_methods(binary)
@@ -429,6 +447,12 @@ def main(argv=None):
             if path and not os.path.isfile(path):
                 raise BatchError("%s: no such file" % path)
         environments = load_environments(args.env, binary)
+        if args.params:  # checked by the tool itself (names, values) before the settings record it
+            check = subprocess.run([binary, environments[0].path, "--info", "--methods", ",".join(args.method_list),
+                                    "--params", os.path.abspath(args.params)],
+                                   capture_output=True, text=True, stdin=subprocess.DEVNULL)
+            if check.returncode != 0:
+                raise BatchError(tool_error(check, "%s --params" % TOOL_NAME).replace("%s: error: " % TOOL_NAME, ""))
         tool_options = ["--resolution", repr(args.resolution)]
         if args.map:
             tool_options += ["--map", os.path.abspath(args.map), "--doors-in-map", os.path.abspath(args.doors_in_map)]

@@ -13,7 +13,6 @@ Two stages:
   show are left out of the order. Written in the closed-door benchmark's layout
   (ENV/NN_doors/{map.yaml, map.pgm, doors.yaml, gt_rooms.png} and cases.csv), in seconds.
 """
-import argparse
 import concurrent.futures
 import csv
 import json
@@ -27,7 +26,7 @@ import yaml
 from tqdm import tqdm
 
 from hidden_rooms.batch_analysis import door_sequence
-from hidden_rooms.package_tools import REPO_DIR, ToolError, find_binary, tool_error
+from hidden_rooms.package_tools import ArgumentParser, REPO_DIR, ToolError, find_binary, tool_error
 
 STORE_FILES = ("map.yaml", "map.png", "doors.yaml", "run.yaml", "exploration.yaml")
 SPLIT_FILE = "split.csv"
@@ -360,7 +359,7 @@ def check(args):
 
 
 def parse_arguments(argv):
-    parser = argparse.ArgumentParser(prog="make_closed_door_corpus", description=__doc__.split("\n\n")[0])
+    parser = ArgumentParser(prog="make_closed_door_corpus", description=__doc__.split("\n\n")[0])
     commands = parser.add_subparsers(dest="command", required=True)
     default_store = os.path.join(REPO_DIR, "data", "closed_door_corpus")
 

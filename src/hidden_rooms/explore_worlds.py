@@ -33,7 +33,7 @@ import numpy as np
 import yaml
 
 from hidden_rooms import batch_analysis
-from hidden_rooms.package_tools import ToolError, find_binary, tool_error
+from hidden_rooms.package_tools import ArgumentParser, ToolError, find_binary, tool_error
 
 SUMMARY_NAME = "summary.csv"
 RESULT_NAME = "result.json"
@@ -319,7 +319,7 @@ def run_worker(args):
 
 
 def parse_arguments(argv):
-    parser = argparse.ArgumentParser(
+    parser = ArgumentParser(
         prog="explore_worlds",
         description="Explore simulated worlds with closed doors (simulator + mapper + explorer), save the maps, "
                     "the pose logs and the closed doors in the map frame, and predict the hidden rooms.")

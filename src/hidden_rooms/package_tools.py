@@ -1,4 +1,5 @@
-"""Finding and running the package's executables from its Python scripts."""
+"""Finding and running the package's executables from its Python scripts, and their command lines."""
+import argparse
 import os
 
 PACKAGE_NAME = "hidden_rooms"
@@ -7,6 +8,14 @@ REPO_DIR = os.path.dirname(os.path.dirname(os.path.dirname(os.path.realpath(__fi
 
 class ToolError(Exception):
     """Unusable arguments or input, or a missing executable (the scripts exit with code 2)."""
+
+
+class ArgumentParser(argparse.ArgumentParser):
+    """argparse's parser, but a bad command line gives one line, as the C++ tools do: "PROG: error: MESSAGE (see
+    --help)" and exit code 2, instead of the whole usage first."""
+
+    def error(self, message):
+        self.exit(2, "%s: error: %s (see --help)\n" % (self.prog, message))
 
 
 def find_binary(name, explicit=None):

@@ -10,7 +10,6 @@ DIR/plots of the first DIR):
                                over all its cases
   table.png                    the same tables as a picture (mean IoU)
 """
-import argparse
 import csv
 import os
 import sys
@@ -18,6 +17,7 @@ import sys
 import numpy as np
 
 from hidden_rooms.batch_analysis import RESULTS_NAME, SIZE_CLASSES, methods_of
+from hidden_rooms.package_tools import ArgumentParser
 
 ALL = "all"
 
@@ -171,7 +171,7 @@ def plot_table(path, tables, methods):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog="plot_batch", description="Plots and tables of batch_analysis results.")
+    parser = ArgumentParser(prog="plot_batch", description="Plots and tables of batch_analysis results.")
     parser.add_argument("folders", nargs="+", metavar="DIR", help="batch_analysis output folder(s)")
     parser.add_argument("--out", help="folder for the plots and tables (default: DIR/plots of the first DIR)")
     args = parser.parse_args(sys.argv[1:] if argv is None else argv)

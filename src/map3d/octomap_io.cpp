@@ -17,6 +17,7 @@
 
 #include "hidden_rooms/common/file_io.h"
 #include "hidden_rooms/common/input_error.h"
+#include "hidden_rooms/common/input_limits.h"
 #include "hidden_rooms/common/label_image.h"
 
 namespace hidden_rooms::map3d {
@@ -26,7 +27,7 @@ namespace {
 constexpr int8_t kFreeMax = 19;      // map_saver's thresholds (percent)
 constexpr int8_t kOccupiedMin = 65;
 constexpr double kEdge = 0.01;      // cells: tolerance of leaf edges against cell edges
-constexpr double kMaxSliceCells = 1e8;
+constexpr size_t kNodesBetweenPrunings = 4000000;  // about 200 MB of nodes
 const cv::Vec3b kWallGrey(90, 90, 90);
 const cv::Vec3b kFreeGrey(220, 220, 220);
 
@@ -51,8 +52,18 @@ void extrude(const common::OccupancyGrid& map, const cv::Mat1w& labels, double h
   // The room (label) a wall cell belongs to: the label of a room cell among its 8 neighbours.
   cv::Mat1w wall_labels;
   if (!labels.empty()) cv::dilate(labels, wall_labels, cv::Mat());
+  size_t prune_at = kNodesBetweenPrunings;
   for (const bool occupied_pass : {false, true}) {
     for (int row = 0; row < map.height(); ++row) {
+      // Pruned when it has grown by kNodesBetweenPrunings (columns of one kind merge into few nodes), so memory
+      // follows the pruned tree.
+      if (tree->size() > prune_at) {
+        tree->prune();
+        common::checkLimit("octomap export", "the octree's number of nodes after pruning",
+                           static_cast<double>(tree->size()), common::kMaxOctreeNodes,
+                           ": the map does not compress; lower --height or coarsen --resolution");
+        prune_at = tree->size() + kNodesBetweenPrunings;
+      }
       for (int col = 0; col < map.width(); ++col) {
         const int8_t value = map.cells(row, col);
         const bool occupied = value >= kOccupiedMin;
@@ -89,12 +100,10 @@ common::OccupancyGrid slice(const Tree& tree, const SliceOptions& options, const
   grid.origin = common::Point2(min_x, min_y);
   const double columns = std::ceil((max_x - min_x) / resolution - kEdge);
   const double rows = std::ceil((max_y - min_y) / resolution - kEdge);
-  if (!(columns * rows <= kMaxSliceCells)) {
-    std::ostringstream problem;
-    problem << "spans " << columns << " x " << rows << " cells at " << resolution
-            << " m (at most 1e8): slice it at a coarser resolution";
-    throw common::InputError(path, problem.str());
-  }
+  if (!std::isfinite(columns * rows)) throw common::InputError(path, "has no finite extent");
+  common::checkLimit(path, "the slice's number of cells (" + common::formatNumber(columns) + " x " +
+                               common::formatNumber(rows) + " at " + common::formatNumber(resolution) + " m)",
+                     columns * rows, common::kMaxMapCells, ": slice it at a coarser resolution");
   const int width = std::max(1, static_cast<int>(columns));
   const int height = std::max(1, static_cast<int>(rows));
   grid.cells = cv::Mat_<int8_t>(height, width, common::OccupancyGrid::kUnknown);
@@ -214,6 +223,16 @@ void exportOctomap(const common::OccupancyGrid& map, const cv::Mat1w& room_label
   const std::string extension = extensionOf(path);
   if (extension != ".ot" && extension != ".bt")
     throw common::InputError(path, "unknown OctoMap file type '" + extension + "' (use .bt or .ot)");
+  // The time it takes: every voxel is visited (about 2 million a second).
+  const double voxels_per_column = std::ceil(options.height / resolution - 1e-9);
+  const double columns = static_cast<double>(cv::countNonZero(map.cells != common::OccupancyGrid::kUnknown));
+  common::checkLimit("octomap export", "the number of voxels (" + common::formatNumber(columns) + " known cells x " +
+                         common::formatNumber(voxels_per_column) + " per column)",
+                     columns * voxels_per_column, common::kMaxVoxels, ": lower --height or coarsen --resolution");
+  octomap::OcTreeKey top;
+  if (!octomap::OcTree(resolution).coordToKeyChecked(octomap::point3d(0.0, 0.0, options.height), top))
+    throw common::InputError("octomap export", "the height " + common::formatNumber(options.height) +
+                                                   " m reaches beyond OctoMap's extent at this resolution");
   common::writeAtomically(path, [&](const std::string& temporary) {
     bool written = false;
     if (extension == ".ot") {

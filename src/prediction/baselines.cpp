@@ -27,7 +27,7 @@ template <typename PredictOne>
 PredictionResult predictEveryDoor(const PredictionRequest& request, double start_search_radius,
                                   PredictOne predict_one) {
   const auto start_time = std::chrono::steady_clock::now();
-  checkUsableMap(request.map);
+  checkUsableRequest(request);
   PredictionResult result;
   for (const common::MapDoor& door : request.doors.doors) {
     RoomPrediction room;
@@ -72,7 +72,7 @@ std::map<std::string, double> UnstructuredPredictor::defaultParameters() const {
 
 PredictionResult UnstructuredPredictor::predict(const PredictionRequest& request) const {
   const double radius = resolveParameters(*this, request.parameters).at("start_search_radius");
-  checkUsableMap(request.map);
+  checkUsableRequest(request);
   const cv::Rect box = knownBoundingBox(request.map);
   return predictEveryDoor(request, radius, [&](const common::MapDoor&, cv::Point start, RoomPrediction* room) {
     // Rays from the centre of the start cell, half a cell apart at the farthest corner of the box.

@@ -984,7 +984,7 @@ PredictionFrames predictionFrames(const PredictionRequest& request, const Defaul
 
 PredictionResult DefaultPredictor::predict(const PredictionRequest& request) const {
   const auto start_time = std::chrono::steady_clock::now();
-  checkUsableMap(request.map);
+  checkUsableRequest(request);
   const auto values = resolveParameters(*this, request.parameters);
   DefaultOptions P;
   common::applyOptionValues(defaultOptionTable(), values, &P, "parameter ");

@@ -2,14 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
-#include <iomanip>
 #include <limits>
 #include <set>
-#include <sstream>
 
 #include <opencv2/imgproc.hpp>
 
 #include "hidden_rooms/common/input_error.h"
+#include "hidden_rooms/common/input_limits.h"
 #include "hidden_rooms/common/label_image.h"
 
 namespace hidden_rooms::prediction {
@@ -22,7 +21,7 @@ bool nearestUnknownCell(const common::OccupancyGrid& map, const common::Point2& 
                         cv::Point* cell, std::string* problem) {
   int col = 0, row = 0;
   if (!map.cellOf(position, &col, &row)) {
-    *problem = "door position (" + std::to_string(position.x()) + ", " + std::to_string(position.y()) +
+    *problem = "door position (" + common::formatNumber(position.x()) + ", " + common::formatNumber(position.y()) +
                ") is outside the map";
     return false;
   }
@@ -94,6 +93,16 @@ void checkUsableMap(const common::OccupancyGrid& map) {
     throw common::InputError("map", "resolution must be positive");
 }
 
+void checkUsableRequest(const PredictionRequest& request) {
+  const double cells = static_cast<double>(request.map.width()) * request.map.height();
+  common::checkLimit("map", "the number of cells", cells, common::kMaxMapCells, ": coarsen or crop the map");
+  const double doors = static_cast<double>(request.doors.doors.size());
+  common::checkLimit("doors", "the number of doors", doors, common::kMaxDoors, ": predict them in several requests");
+  common::checkLimit("doors", "doors x map cells", doors * cells, common::kMaxDoorCells,
+                     ": each door's room is a mask of the map's size; predict fewer doors per request");
+  checkUsableMap(request.map);
+}
+
 void checkDoorsInsideMap(const common::OccupancyGrid& map, const common::DoorsFile& doors) {
   std::set<int> ids;
   for (const common::MapDoor& door : doors.doors) {
@@ -101,12 +110,13 @@ void checkDoorsInsideMap(const common::OccupancyGrid& map, const common::DoorsFi
       throw common::InputError("doors", "door id " + std::to_string(door.id) + " is used twice");
     int col = 0, row = 0;
     if (!map.cellOf(door.position, &col, &row)) {
-      std::ostringstream problem;
-      problem << std::fixed << std::setprecision(2) << "position (" << door.position.x() << ", "
-              << door.position.y() << ") is outside the map (x " << map.origin.x() << " .. "
-              << map.origin.x() + map.width() * map.resolution << ", y " << map.origin.y() << " .. "
-              << map.origin.y() + map.height() * map.resolution << " m)";
-      throw common::InputError("door " + std::to_string(door.id), problem.str());
+      throw common::InputError(
+          "door " + std::to_string(door.id),
+          "position (" + common::formatNumber(door.position.x()) + ", " + common::formatNumber(door.position.y()) +
+              ") is outside the map (x " + common::formatNumber(map.origin.x()) + " .. " +
+              common::formatNumber(map.origin.x() + map.width() * map.resolution) + ", y " +
+              common::formatNumber(map.origin.y()) + " .. " +
+              common::formatNumber(map.origin.y() + map.height() * map.resolution) + " m)");
     }
   }
 }

@@ -41,7 +41,7 @@ RoomPrediction roomFromCells(const common::OccupancyGrid& map, const Layout& lay
 
 PredictionResult StructuredPredictor::predict(const PredictionRequest& request) const {
   const auto start_time = std::chrono::steady_clock::now();
-  checkUsableMap(request.map);
+  checkUsableRequest(request);
   const LayoutOptions options = layoutOptionsFromParameters(resolveParameters(*this, request.parameters));
   const Layout layout = analyzeLayout(request.map, request.doors.doors, options, request.debug_dir);
 

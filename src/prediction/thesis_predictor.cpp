@@ -244,7 +244,7 @@ std::map<std::string, double> ThesisPredictor::defaultParameters() const {
 
 PredictionResult ThesisPredictor::predict(const PredictionRequest& request) const {
   const auto start_time = std::chrono::steady_clock::now();
-  checkUsableMap(request.map);
+  checkUsableRequest(request);
   const std::map<std::string, double> parameters = resolveParameters(*this, request.parameters);
   std::map<std::string, double> layout_parameters;
   for (const std::string& name : layoutParameterNames()) layout_parameters[name] = parameters.at(name);

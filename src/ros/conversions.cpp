@@ -62,8 +62,19 @@ common::OccupancyGrid fromRos(const nav_msgs::OccupancyGrid& message) {
   if (!(info.resolution > 0.0f) || !std::isfinite(info.resolution))
     throw common::InputError("map message", "resolution must be positive");
   const auto& q = info.origin.orientation;
+  const double norm = std::sqrt(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w);
+  if (!(std::abs(norm - 1.0) < 1e-3))
+    throw common::InputError("map message", "the origin's orientation is not a unit quaternion (norm " +
+                                                common::formatNumber(norm) + "; an unrotated map has w = 1)");
   const double yaw = std::atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z));
   if (std::abs(yaw) > 1e-6) throw common::InputError("map message", "rotated map origins are not supported");
+  if (!std::isfinite(info.origin.position.x) || !std::isfinite(info.origin.position.y))
+    throw common::InputError("map message", "the origin is not finite");
+  const auto bad_value = std::find_if(message.data.begin(), message.data.end(),
+                                      [](int8_t value) { return value < -1 || value > 100; });
+  if (bad_value != message.data.end())
+    throw common::InputError("map message", "cell " + std::to_string(bad_value - message.data.begin()) + " is " +
+                                                std::to_string(*bad_value) + " (values are -1 unknown or 0..100)");
   common::OccupancyGrid grid;
   grid.resolution = floatToDouble(info.resolution);
   grid.origin = common::Point2(info.origin.position.x, info.origin.position.y);

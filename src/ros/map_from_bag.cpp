@@ -162,6 +162,9 @@ int run(int argc, char** argv) {
                                    topicsOfType(bag, "nav_msgs/Odometry") + ")");
   const double bag_start = view.getBeginTime().toSec(), bag_end = view.getEndTime().toSec();
   const double bag_seconds = std::max(bag_end - bag_start, 1e-9);
+  if (!(bag_seconds < 1e9))  // ros::Duration's range is 2^31 s
+    throw InputError(bag_path, "its messages span " + hidden_rooms::common::formatNumber(bag_seconds) +
+                                   " s: the bag's index is damaged");
 
   tf2::BufferCore tf_buffer(ros::Duration(std::max(60.0, bag_seconds + 10.0)));
   std::deque<sensor_msgs::LaserScan::ConstPtr> pending;
@@ -316,5 +319,11 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  return hidden_rooms::common::runTool("map_from_bag", [&] { return run(argc, argv); });
+  return hidden_rooms::common::runTool("map_from_bag", [&] {
+    try {
+      return run(argc, argv);
+    } catch (const ros::Exception& error) {  // rosbag's and the message deserializers' errors: a damaged bag
+      throw InputError("bag", std::string("cannot be read, it is damaged: ") + error.what());
+    }
+  });
 }

@@ -63,6 +63,8 @@ int run(int argc, char** argv) {
   }
   cv::Mat truth;
   if (!gt_path.empty()) truth = evaluation::loadTrueRooms(gt_path, request.map);
+  common::OutputFolder out(
+      out_dir, {doors_path, params_path, gt_path, map_path, map_path.empty() ? "" : common::mapImagePath(map_path)});
   service.request.doors = toRos(request.doors);
   service.request.method = method;
   service.request.parameters = toRos(request.parameters);
@@ -80,7 +82,7 @@ int run(int argc, char** argv) {
     throw common::InputError(resolved, "answered " + std::to_string(result.rooms.size()) + " rooms for " +
                                            std::to_string(request.doors.doors.size()) + " doors");
   const evaluation::PredictionOutputs outputs =
-      evaluation::writePredictionOutputs(request, result, service.response.method, out_dir, truth);
+      evaluation::writePredictionOutputs(request, result, service.response.method, &out, truth);
   evaluation::printPredictionSummary(std::cout, request, result, service.response.method, out_dir, outputs);
   return common::kExitOk;
 }

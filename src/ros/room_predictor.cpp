@@ -7,6 +7,7 @@
 #include <visualization_msgs/MarkerArray.h>
 
 #include "hidden_rooms/common/input_error.h"
+#include "hidden_rooms/common/input_limits.h"
 #include "hidden_rooms/map3d/octomap_io.h"
 #include "hidden_rooms/prediction/layout.h"
 #include "hidden_rooms/prediction/prediction_support.h"
@@ -30,8 +31,9 @@ const common::OptionTable<RoomPredictorOptions>& roomPredictorNodeOptionTable() 
       {"octomap_z_max", &O::octomap_z_max, "metres: top of the height band of ~octomap_file"},
       {"octomap_out", &O::octomap_out, "after each prediction, the completed map extruded into 3D and written here"},
       {"octomap_height", &O::octomap_height, "metres: height of the extruded walls and free space", common::above(0)},
-      {"max_doors", &O::max_doors, "requests with more doors are refused", common::atLeast(1)},
-      {"max_map_cells", &O::max_map_cells, "maps with more cells (width x height) are refused", common::atLeast(1)},
+      {"max_doors", &O::max_doors, "requests with more doors are refused", common::between(1, common::kMaxDoors)},
+      {"max_map_cells", &O::max_map_cells, "maps with more cells (width x height) are refused",
+       common::between(1, common::kMaxMapCells)},
   };
   return table;
 }
@@ -124,8 +126,10 @@ void RoomPredictorNode::predict(const PredictRooms::Request& request, PredictRoo
   if (!request.doors.empty()) {
     core.doors = fromRos(request.doors, frame);
   } else if (default_doors_) {
+    if (default_doors_->frame != frame)
+      throw common::InputError("~closed_doors_file", "its doors are in frame '" + default_doors_->frame +
+                                                         "', the map in '" + frame + "'");
     core.doors = *default_doors_;
-    core.doors.frame = frame;
   } else {
     throw common::InputError("doors", "the request has no doors and the node has no ~closed_doors_file");
   }

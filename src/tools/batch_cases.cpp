@@ -93,7 +93,8 @@ int run(int argc, char** argv) {
   bool info = false;
   options.add_options()
       ("environment", po::value(&environment_path)->required(), "environment XML (thesis schema)")
-      ("info", po::bool_switch(&info), "print the environment's closable doors (JSON) and exit")
+      ("info", po::bool_switch(&info), "print the environment's closable doors (JSON) and exit (after checking "
+                                        "--methods and --params)")
       ("sequence", po::value(&sequence_text), "door numbers in closing order, comma-separated")
       ("cases", po::value(&cases_text), "numbers of closed doors to run, comma-separated (default: 1..length)")
       ("methods", po::value(&methods_text), "prediction methods, comma-separated")
@@ -115,7 +116,7 @@ int run(int argc, char** argv) {
       "Usage: batch_cases ENV.xml --sequence D1,D2,... --methods A,B [--cases K,...]\n"
       "                   [--params F.yaml] [--map MAP.yaml --doors-in-map DOORS.yaml]\n"
       "                   [--write-cases DIR]\n"
-      "       batch_cases ENV.xml --info\n"
+      "       batch_cases ENV.xml --info [--methods A,B] [--params F.yaml]\n"
       "Methods: " + methods_known + "\n"
       "Case K closes the first K doors of the sequence, erases the rooms behind them, paints\n"
       "the doors as walls, runs every method and scores it against the true rooms; prints one\n"
@@ -126,6 +127,15 @@ int run(int argc, char** argv) {
     return common::kExitOk;
 
   const world::Environment environment = world::loadEnvironment(environment_path);
+  std::vector<std::unique_ptr<prediction::RoomPredictor>> methods;
+  for (const std::string& name : splitList(methods_text)) methods.push_back(prediction::makeRoomPredictor(name));
+  std::map<std::string, double> parameters;
+  if (!params_path.empty()) parameters = prediction::loadParameterFile(params_path);
+  try {  // unknown names fail up front
+    for (const auto& method : methods) prediction::resolveParameters(*method, parameters);
+  } catch (const common::InputError& error) {
+    throw common::InputError(params_path.empty() ? error.source() : params_path, error.problem());
+  }
   if (info) {
     printInfo(environment_path, environment);
     return common::kExitOk;
@@ -141,11 +151,6 @@ int run(int argc, char** argv) {
     if (k > static_cast<int>(sequence.size()))
       throw common::InputError("--cases",
                                std::to_string(k) + " doors but the sequence has " + std::to_string(sequence.size()));
-  std::vector<std::unique_ptr<prediction::RoomPredictor>> methods;
-  for (const std::string& name : splitList(methods_text)) methods.push_back(prediction::makeRoomPredictor(name));
-  std::map<std::string, double> parameters;
-  if (!params_path.empty()) parameters = prediction::loadParameterFile(params_path);
-  for (const auto& method : methods) prediction::resolveParameters(*method, parameters);  // unknown names fail up front
   std::optional<common::OccupancyGrid> complete_map;
   common::DoorsFile doors_in_map;
   if (!map_path.empty()) {

@@ -3,7 +3,6 @@
 // what explore_worlds keeps of an online run: the map, both pose logs and the doors in the map frame.
 #include <chrono>
 #include <cstdio>
-#include <filesystem>
 #include <iomanip>
 #include <iostream>
 #include <sstream>
@@ -106,14 +105,13 @@ int run(int argc, char** argv) {
       evaluation::translateDoors(environment, open_closable, result.truth, result.estimate, door_width, true);
 
   // Created only now: bad input (a missing or malformed ini, ...) writes nothing.
-  common::createOutputDirectory(out_dir);
-  const std::filesystem::path out(out_dir);
-  common::saveMap(result.map, (out / "map").string(), ".png");
-  common::writeTextAtomically((out / "truth.log").string(),
+  common::OutputFolder out(out_dir, {environment_path, config_path});
+  common::saveMap(result.map, out.mapPrefix("map", ".png"), ".png");
+  common::writeTextAtomically(out.file("truth.log"),
                               poseLogText("world", "base_link (ground truth)", result.truth, pose_period), "pose log");
-  common::writeTextAtomically((out / "estimate.log").string(),
-                              poseLogText("map", "base_link", result.estimate, pose_period), "pose log");
-  common::saveDoors(doors, (out / "doors.yaml").string());
+  common::writeTextAtomically(out.file("estimate.log"), poseLogText("map", "base_link", result.estimate, pose_period),
+                              "pose log");
+  common::saveDoors(doors, out.file("doors.yaml"));
   std::ostringstream report;
   report << std::fixed << std::setprecision(2) << "# explore_offline: " << environment_path << "\n"
          << "stop: " << pipeline::toString(result.stop) << "\n"
@@ -125,7 +123,8 @@ int run(int argc, char** argv) {
          << "scans: " << result.scans << "\n"
          << "scans_inserted: " << result.scans_inserted << "\n"
          << "goals: " << result.goals << "\n";
-  common::writeTextAtomically((out / "run.yaml").string(), report.str(), "run report");
+  common::writeTextAtomically(out.file("run.yaml"), report.str(), "run report");
+  out.commit();
   std::cout << "explore_offline: " << pipeline::toString(result.stop) << " after " << std::fixed
             << std::setprecision(0) << result.simulated_seconds << " simulated s in " << wall << " s ("
             << std::setprecision(1) << result.simulated_seconds / std::max(wall, 1e-9) << "x), " << doors.doors.size()

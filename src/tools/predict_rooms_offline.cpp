@@ -48,11 +48,11 @@ int run(int argc, char** argv) {
   cv::Mat truth;
   if (!gt_path.empty()) truth = evaluation::loadTrueRooms(gt_path, request.map);
   if (!debug_dir.empty()) common::createOutputDirectory(debug_dir);
+  common::OutputFolder out(out_dir, {map_path, common::mapImagePath(map_path), doors_path, params_path, gt_path});
 
   const prediction::PredictionResult result = predictor->predict(request);
 
-  const evaluation::PredictionOutputs outputs =
-      evaluation::writePredictionOutputs(request, result, method, out_dir, truth);
+  const evaluation::PredictionOutputs outputs = evaluation::writePredictionOutputs(request, result, method, &out, truth);
   evaluation::printPredictionSummary(std::cout, request, result, method, out_dir, outputs);
   return common::kExitOk;
 }

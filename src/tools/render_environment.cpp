@@ -1,6 +1,5 @@
 // render_environment ENV.xml --out DIR [--resolution R] [--closed ID,...|all]: the ground truth of an
 // environment as a map_server map, a label image of its spaces, its closed doors and a preview.
-#include <filesystem>
 #include <iostream>
 #include <optional>
 #include <set>
@@ -58,13 +57,13 @@ int run(int argc, char** argv) {
   std::optional<world::HiddenRoomsCase> hidden;
   if (hide_rooms) hidden = world::hideClosedRooms(environment, rendered);
 
-  common::createOutputDirectory(out_dir);
-  const std::filesystem::path out(out_dir);
-  common::saveMap(hidden ? hidden->map : rendered.map, (out / "map").string());
-  common::saveLabelImage(rendered.space_labels, (out / "spaces.png").string());
-  common::saveDoors(rendered.closed_doors, (out / "doors.yaml").string());
-  if (hidden) common::saveLabelImage(hidden->true_rooms, (out / "true_rooms.png").string());
-  common::writeImage((out / "preview.png").string(), world::renderPreview(environment, rendered));
+  common::OutputFolder out(out_dir, {environment_path});
+  common::saveMap(hidden ? hidden->map : rendered.map, out.mapPrefix("map"));
+  common::saveLabelImage(rendered.space_labels, out.file("spaces.png"));
+  common::saveDoors(rendered.closed_doors, out.file("doors.yaml"));
+  if (hidden) common::saveLabelImage(hidden->true_rooms, out.file("true_rooms.png"));
+  common::writeImage(out.file("preview.png"), world::renderPreview(environment, rendered));
+  out.commit();
 
   std::cout << environment_path << ": " << environment.spaces.size() << " spaces, " << environment.doors.size()
             << " doors (" << world::closableDoors(environment).size() << " closable), "

@@ -92,15 +92,17 @@ int run(int argc, char** argv) {
 
   const common::DoorsFile doors =
       evaluation::translateDoors(environment, door_indices, truth.poses, estimate.poses, door_width);
-  common::createOutputDirectory(out_dir);
-  const std::filesystem::path out(out_dir);
-  common::saveDoors(doors, (out / "doors.yaml").string());
-  std::cout << "translate_doors: " << doors.doors.size() << " closed doors -> " << (out / "doors.yaml").string()
-            << std::endl;
-  if (map_path.empty()) return common::kExitOk;
+  const common::OccupancyGrid map = map_path.empty() ? common::OccupancyGrid() : common::loadMap(map_path);
+  common::OutputFolder out(out_dir, {environment_path, truth_path, estimate_path, map_path});
+  common::saveDoors(doors, out.file("doors.yaml"));
+  if (map_path.empty()) {
+    out.commit();
+    std::cout << "translate_doors: " << doors.doors.size() << " closed doors -> " << (std::filesystem::path(out_dir) / "doors.yaml").string()
+              << std::endl;
+    return common::kExitOk;
+  }
 
   // Scoring: the world placed in the map frame by the least-squares fit of the two trajectories.
-  const common::OccupancyGrid map = common::loadMap(map_path);
   const common::Pose2 world_from_map = evaluation::fitWorldFromMap(truth.poses, estimate.poses);
   const common::Pose2 start = truth.poses.front().pose;
   const cv::Mat1b reachable =
@@ -110,7 +112,7 @@ int run(int argc, char** argv) {
       map, world_from_map, rendered.map, evaluation::reachableFreeArea(rendered.map, common::Point2(start.x, start.y)));
   const cv::Mat1w true_rooms = evaluation::trueRoomsInMap(environment, door_indices,
                                                           evaluation::spaceLabelsInMap(rendered, map, world_from_map));
-  common::saveLabelImage(true_rooms, (out / "true_rooms.png").string());
+  common::saveLabelImage(true_rooms, out.file("true_rooms.png"));
 
   const auto coverageOf = [](const evaluation::MapQuality& q) {
     return q.true_free_cells ? double(q.intersection_cells) / double(q.true_free_cells) : 0.0;
@@ -149,11 +151,14 @@ int run(int argc, char** argv) {
            << "], error: " << error << ", global_error: " << global_error << ", to_mapped_wall: " << (std::isfinite(to_wall) ? std::to_string(to_wall) : std::string(".inf"))
            << "}\n";
   }
-  common::writeTextAtomically((out / "exploration.yaml").string(), report.str(), "exploration report");
+  common::writeTextAtomically(out.file("exploration.yaml"), report.str(), "exploration report");
+  out.commit();
+  std::cout << "translate_doors: " << doors.doors.size() << " closed doors -> " << (std::filesystem::path(out_dir) / "doors.yaml").string()
+            << std::endl;
   std::cout << "translate_doors: coverage " << std::fixed << std::setprecision(3)
             << coverage << " (all free cells " << coverageOf(all_free) << ")"
             << ", free IoU " << all_free.free_iou << ", worst door error " << worst_error << " m -> "
-            << (out / "exploration.yaml").string() << std::endl;
+            << (std::filesystem::path(out_dir) / "exploration.yaml").string() << std::endl;
   return common::kExitOk;
 }
 

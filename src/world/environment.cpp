@@ -13,6 +13,7 @@
 
 #include "hidden_rooms/common/file_io.h"
 #include "hidden_rooms/common/input_error.h"
+#include "hidden_rooms/common/input_limits.h"
 
 namespace hidden_rooms::world {
 
@@ -308,6 +309,7 @@ Environment parseEnvironment(const std::string& xml_text, const std::string& sou
     if (space.id.empty()) throw common::InputError(source, "<space> at " + lineOf(element) + " has no id");
     if (!space_line.emplace(space.id, element->GetLineNum()).second)
       throw common::InputError(source, "space id '" + space.id + "' at " + lineOf(element) + " is used twice");
+    common::checkLimit(source, "the number of spaces", static_cast<double>(space_line.size()), common::kMaxSpaces);
     if (const XMLElement* labels = element->FirstChildElement("labels")) {
       space.type = childText(labels, "type");
       space.label = childText(labels, "label");
@@ -539,12 +541,14 @@ std::set<int> parseDoorSelection(const Environment& environment, const std::stri
       if (environment.doors[d].space_indices.size() >= 2) selected.insert(static_cast<int>(d));
     return selected;
   }
-  std::stringstream items(spec);
+  if (spec.find_first_not_of(' ') == std::string::npos) return selected;  // no door
+  std::stringstream items(spec + ",");  // the comma makes a trailing empty item show
   std::string item;
   while (std::getline(items, item, ',')) {
     item.erase(0, item.find_first_not_of(' '));
     item.erase(item.find_last_not_of(' ') + 1);
-    if (item.empty()) continue;
+    if (item.empty())
+      throw common::InputError(source_name, "'" + spec + "' has an empty door number between its commas");
     const int index = environment.findDoor(item);
     if (index < 0)
       throw common::InputError(source_name, "no door '" + item + "' (door numbers are 1.." +

@@ -7,13 +7,13 @@
 
 #include "hidden_rooms/common/image_io.h"
 #include "hidden_rooms/common/input_error.h"
+#include "hidden_rooms/common/input_limits.h"
 
 namespace hidden_rooms::world {
 
 namespace {
 
 constexpr int kSubpixelBits = 8;  // cv::fillPoly shift: polygon vertices with 1/256 cell precision
-constexpr double kMaxCells = 4e8;
 constexpr double kSameLineAngle = 10.0 * 3.14159265358979323846 / 180.0;
 // Largest distance (metres) between the two drawings of one wall by the two spaces it separates.
 constexpr double kMaxDoubleWallOffset = 0.5;
@@ -159,8 +159,8 @@ RenderedEnvironment renderEnvironment(const Environment& environment, const std:
   grid.resolution = resolution;
   grid.origin = ((low.array() - options.margin) / resolution).floor() * resolution;
   const Eigen::Array2d cells = ((high - grid.origin).array() + options.margin) / resolution;
-  if (cells.x() * cells.y() > kMaxCells)
-    throw common::InputError("render options", "the map would have more than 4e8 cells: raise the resolution");
+  common::checkLimit("render options", "the map's number of cells", cells.x() * cells.y(), common::kMaxMapCells,
+                     ": raise the resolution");
   grid.cells.create(static_cast<int>(std::ceil(cells.y())), static_cast<int>(std::ceil(cells.x())));
   grid.cells.setTo(common::OccupancyGrid::kUnknown);
   result.space_labels = cv::Mat1w::zeros(grid.cells.size());

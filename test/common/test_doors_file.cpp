@@ -93,6 +93,10 @@ TEST(DoorsFile, BadDoorsFilesGiveClearErrors) {
   expectError("doors:\n- {id: 1, position: [1, 2], width: 0.9, orientation: O, map_from_world: [1, 2, .inf]}\n",
               "map_from_world[2] is not finite");
   EXPECT_THROW(loadDoors("/nonexistent/doors.yaml"), InputError);
+  std::string crowd = "doors:\n";
+  for (int id = 1; id <= 501; ++id)
+    crowd += "- {id: " + std::to_string(id) + ", position: [1, 2], width: 0.9, orientation: O}\n";
+  expectError(crowd, "the number of doors is 501, more than the limit of 500");
 }
 
 }  // namespace

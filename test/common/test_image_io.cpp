@@ -94,7 +94,7 @@ TEST(ImageIo, BadFilesGiveErrorsNamingTheFile) {
   writeBytes(dir + "/cut.pgm", "P5\n4 4\n255\nabc");
   expectReadError(dir + "/cut.pgm", "truncated");
   writeBytes(dir + "/huge.pgm", "P5\n65536 65536\n255\n");
-  expectReadError(dir + "/huge.pgm", "truncated");
+  expectReadError(dir + "/huge.pgm", "more than the limit");
   writeBytes(dir + "/letters.pgm", "P2\nthree 2\n255\n");
   expectReadError(dir + "/letters.pgm", "not a number");
   writeBytes(dir + "/zero.pgm", "P5\n0 2\n255\n");
@@ -106,7 +106,7 @@ TEST(ImageIo, BadFilesGiveErrorsNamingTheFile) {
   EXPECT_THROW(writeImage(dir + "/colour.pgm", randomImage(CV_8UC3)), InputError);
   EXPECT_THROW(writeImage(dir + "/float.png", cv::Mat1f(2, 2, 0.5f)), InputError);
   EXPECT_THROW(writeImage(dir + "/empty.png", cv::Mat()), InputError);
-  EXPECT_THROW(writeImage(dir + "/no_such_dir/a.png", randomImage(CV_8UC1)), InputError);
+  EXPECT_THROW(writeImage(dir + "/good.png/a.png", randomImage(CV_8UC1)), InputError);  // a file as folder
 }
 
 TEST(ImageIo, ReadsTheBenchmarkImagesLikeOpenCv) {
@@ -142,7 +142,10 @@ TEST(FileIo, WritesAtomicallyAndLeavesNoPartialFile) {
   // An image write that fails (unsupported pixel type) leaves nothing either.
   EXPECT_THROW(writeImage(dir + "/bad.png", cv::Mat(2, 2, CV_32FC1, cv::Scalar(0))), InputError);
   EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir), std::filesystem::directory_iterator()), 1);
-  EXPECT_THROW(writeTextAtomically(dir + "/no/such/folder/x.txt", "x", "test file"), InputError);
+  // Missing parent folders are created (export_octomap --out new/folder/map.bt).
+  writeTextAtomically(dir + "/new/folder/x.txt", "x", "test file");
+  EXPECT_EQ(readTextFile(dir + "/new/folder/x.txt", "test file"), "x");
+  EXPECT_THROW(writeTextAtomically(dir + "/out.txt/x.txt", "x", "test file"), InputError);  // a file as parent
 }
 
 TEST(FileIo, RemovesTheTemporariesOfKilledWriters) {
@@ -162,6 +165,88 @@ TEST(FileIo, RemovesTheTemporariesOfKilledWriters) {
   EXPECT_FALSE(std::filesystem::exists(dead));
   EXPECT_TRUE(std::filesystem::exists(alive));
   EXPECT_TRUE(std::filesystem::exists(other));
+}
+
+// The output folder of a run: every file or none, the previous run's set kept on failure, one run at a time, and
+// never an input replaced.
+TEST(OutputFolder, WritesTheWholeSetOrNothing) {
+  const std::string dir = testing::makeTempDir("output_folder");
+  const std::string out = dir + "/out";
+  {
+    OutputFolder folder(out, {});
+    writeTextAtomically(folder.file("a.txt"), "first a", "test file");
+    writeTextAtomically(folder.file("b.txt"), "first b", "test file");
+    EXPECT_FALSE(std::filesystem::exists(out + "/a.txt")) << "nothing is in place before commit()";
+    folder.commit();
+  }
+  const std::vector<std::string> first_set{"a.txt", "b.txt"};
+  EXPECT_EQ(testing::fileNames(out), first_set) << "the staging folder is gone";
+  {
+    // A run that fails after writing one file changes nothing.
+    OutputFolder folder(out, {});
+    writeTextAtomically(folder.file("a.txt"), "second a", "test file");
+  }
+  {
+    OutputFolder folder(dir + "/never", {});  // a folder it created, left empty: removed
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir + "/never"));
+  EXPECT_EQ(readTextFile(out + "/a.txt", "test file"), "first a");
+  EXPECT_EQ(testing::fileNames(out), first_set);
+  {
+    // A blocked name (a folder where a file goes) is found before anything moves.
+    OutputFolder folder(out, {});
+    writeTextAtomically(folder.file("a.txt"), "third a", "test file");
+    writeTextAtomically(folder.file("c.txt"), "third c", "test file");
+    std::filesystem::create_directory(out + "/c.txt");
+    EXPECT_NE(testing::inputErrorMessage([&] { folder.commit(); }).find("c.txt: is a folder"), std::string::npos);
+    EXPECT_EQ(readTextFile(out + "/a.txt", "test file"), "first a");
+  }
+}
+
+TEST(OutputFolder, OneRunAtATimeAndNoInputReplaced) {
+  const std::string dir = testing::makeTempDir("output_folder_lock");
+  const std::string out = dir + "/out";
+  std::filesystem::create_directories(out);
+  {
+    OutputFolder first(out, {});
+    EXPECT_NE(testing::inputErrorMessage([&] { OutputFolder second(out, {}); }).find("another run is writing"),
+              std::string::npos);
+  }
+  std::ofstream(out + "/map.yaml") << "image: map.pgm\n";
+  OutputFolder folder(dir + "/./out/", {out + "/map.yaml", ""});  // the lock went with the first run
+  EXPECT_NO_THROW(folder.file("rooms.png"));
+  EXPECT_NE(testing::inputErrorMessage([&] { folder.file("map.yaml"); }).find("would replace the input"),
+            std::string::npos);
+  EXPECT_EQ(readTextFile(out + "/map.yaml", "test file"), "image: map.pgm\n");
+}
+
+TEST(OutputFolder, RemovesTheStagingFoldersOfKilledRuns) {
+  const std::string dir = testing::makeTempDir("output_folder_stale");
+  const pid_t child = fork();
+  if (child == 0) _exit(0);
+  ASSERT_GT(child, 0);
+  ASSERT_EQ(waitpid(child, nullptr, 0), child);
+  std::filesystem::create_directories(dir + "/.partial" + std::to_string(child));
+  std::ofstream(dir + "/.partial" + std::to_string(child) + "/rooms.png") << "half";
+  OutputFolder folder(dir, {});
+  EXPECT_FALSE(std::filesystem::exists(dir + "/.partial" + std::to_string(child)));
+}
+
+TEST(ImageIo, AnImageDeclaringTooManyPixelsIsRefusedBeforeItsPixelsAreAllocated) {
+  const std::string dir = testing::makeTempDir("image_limit");
+  // A PNG of 45 bytes whose header declares 100000 x 100000 grey pixels (1e10 bytes): signature, IHDR, an empty
+  // IDAT (the header ends at the first IDAT).
+  const unsigned char png[] = {0x89, 'P',  'N',  'G',  0x0d, 0x0a, 0x1a, 0x0a, 0x00, 0x00, 0x00, 0x0d, 'I',  'H',  'D',
+                               'R',  0x00, 0x01, 0x86, 0xa0, 0x00, 0x01, 0x86, 0xa0, 0x08, 0x00, 0x00, 0x00, 0x00, 0x8d,
+                               0x39, 0x54, 0x14, 0x00, 0x00, 0x00, 0x00, 'I',  'D',  'A',  'T',  0x35, 0xaf, 0x06, 0x1e};
+  std::ofstream(dir + "/huge.png", std::ios::binary).write(reinterpret_cast<const char*>(png), sizeof(png));
+  std::ofstream(dir + "/huge.pgm") << "P5\n60000 60000\n255\n";
+  for (const char* name : {"/huge.png", "/huge.pgm"}) {
+    const std::string message = testing::inputErrorMessage([&] { readImage(dir + name); });
+    EXPECT_NE(message.find("more than the limit of 25000000 pixels"), std::string::npos) << message;
+  }
+  EXPECT_NE(testing::inputErrorMessage([&] { readImage(dir); }).find("is a folder, not an image file"),
+            std::string::npos);
 }
 
 }  // namespace

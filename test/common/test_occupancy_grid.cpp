@@ -77,6 +77,14 @@ TEST(OccupancyGrid, CellsAndCoordinatesAgree) {
   EXPECT_EQ(row, 0);
   EXPECT_FALSE(grid.cellOf(Point2(9.9, 21.0), &col, &row));
   EXPECT_FALSE(grid.cellOf(Point2(std::nan(""), 21.0), &col, &row));
+  EXPECT_FALSE(grid.cellOf(Point2(1e308, 21.0), &col, &row));
+  // The map's edges belong to it: the origin is in the bottom-left cell, the far corner in the top-right one.
+  ASSERT_TRUE(grid.cellOf(Point2(10, 20), &col, &row));
+  EXPECT_EQ(col, 0);
+  EXPECT_EQ(row, 3);
+  ASSERT_TRUE(grid.cellOf(Point2(13, 22), &col, &row));
+  EXPECT_EQ(col, 5);
+  EXPECT_EQ(row, 0);
   for (int r = 0; r < 4; ++r)
     for (int c = 0; c < 6; ++c) {
       ASSERT_TRUE(grid.cellOf(grid.cellCentre(c, r), &col, &row));
@@ -133,6 +141,8 @@ TEST(OccupancyGrid, BadMapFilesGiveClearErrors) {
   writeText(dir + "/bad_origin.yaml", "image: ok.png\nresolution: 0.05\norigin: [0, .nan, 0]\n"
                                       "occupied_thresh: 0.65\nfree_thresh: 0.196\n");
   writeText(dir + "/bad_mode.yaml", mapYaml("ok.png", "mode: fancy\n"));
+  writeText(dir + "/negate_7.yaml", "image: ok.png\nresolution: 0.1\norigin: [0, 0, 0]\nnegate: 7\n");
+  expectLoadError(dir + "/negate_7.yaml", "negate is 7 (0 or 1)");
   expectLoadError(dir + "/missing_image.yaml", "does not exist");
   expectLoadError(dir + "/unreadable_image.yaml", "cannot be read as an image");
   expectLoadError(dir + "/negative_resolution.yaml", "resolution must be positive");

@@ -170,7 +170,21 @@ TEST(OctomapIo, BadInputGivesClearErrors) {
   EXPECT_THROW(exportOctomap(map, cv::Mat1w(), flat, dir + "/map.bt"), common::InputError);
   EXPECT_THROW(exportOctomap(common::OccupancyGrid(), cv::Mat1w(), ExtrusionOptions(), dir + "/map.bt"),
                common::InputError);
-  EXPECT_THROW(exportOctomap(map, cv::Mat1w(), ExtrusionOptions(), dir + "/no/such/folder/map.bt"), common::InputError);
+  exportOctomap(map, cv::Mat1w(), ExtrusionOptions(), dir + "/new/folder/map.bt");  // missing parents are created
+  EXPECT_TRUE(std::filesystem::is_regular_file(dir + "/new/folder/map.bt"));
+  // Heights beyond the voxel limit (export_octomap --height 100 used to take 23 GB) or OctoMap's extent.
+  ExtrusionOptions tall;
+  tall.height = 1e9;
+  EXPECT_NE(inputErrorMessage([&] { exportOctomap(map, cv::Mat1w(), tall, dir + "/tall.bt"); })
+                .find("the number of voxels (100 known cells x 2e+10 per column) is 2e+12, more than the limit"),
+            std::string::npos);
+  common::OccupancyGrid one_cell;
+  one_cell.cells = cv::Mat_<int8_t>(1, 1, common::OccupancyGrid::kFree);
+  tall.height = 5000.0;
+  EXPECT_NE(inputErrorMessage([&] { exportOctomap(one_cell, cv::Mat1w(), tall, dir + "/tall.bt"); })
+                .find("the height 5000 m reaches beyond OctoMap's extent"),
+            std::string::npos);
+  EXPECT_FALSE(std::filesystem::exists(dir + "/tall.bt"));
 }
 
 // OctoMap's readers follow a file's child bits past its end and to any depth (the fuzzer's out-of-memory input

@@ -9,6 +9,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "hidden_rooms/common/input_error.h"
+#include "hidden_rooms/common/input_limits.h"
 #include "hidden_rooms/common/label_image.h"
 #include "hidden_rooms/evaluation/evaluation.h"
 #include "hidden_rooms/prediction/prediction_support.h"
@@ -140,6 +141,35 @@ TEST(Prediction, EmptyOrUnknownMapsAreRejected) {
   request.map.cells = cv::Mat_<int8_t>(10, 10, common::OccupancyGrid::kUnknown);
   for (const std::string& name : roomPredictorNames())
     EXPECT_THROW(makeRoomPredictor(name)->predict(request), common::InputError);
+}
+
+// Sizes beyond common/input_limits.h are refused by every method before any work, naming the limit.
+TEST(Prediction, RequestsBeyondTheLimitsAreRefused) {
+  auto [request, truth] = hiddenRoomA();
+  PredictionRequest many_doors = request;
+  for (int id = 100; many_doors.doors.doors.size() <= common::kMaxDoors; ++id) {
+    common::MapDoor door = request.doors.doors[0];
+    door.id = id;
+    many_doors.doors.doors.push_back(door);
+  }
+  PredictionRequest huge_map = request;
+  huge_map.map.cells = cv::Mat_<int8_t>(5001, 5000, common::OccupancyGrid::kFree);
+  PredictionRequest doors_on_a_large_map = huge_map;
+  doors_on_a_large_map.map.cells = cv::Mat_<int8_t>(4000, 4000, common::OccupancyGrid::kFree);
+  doors_on_a_large_map.doors.doors.resize(100, request.doors.doors[0]);
+  for (const std::string& name : roomPredictorNames()) {
+    SCOPED_TRACE(name);
+    const std::unique_ptr<RoomPredictor> predictor = makeRoomPredictor(name);
+    EXPECT_NE(testing::inputErrorMessage([&] { predictor->predict(many_doors); })
+                  .find("the number of doors is 501, more than the limit of 500"),
+              std::string::npos);
+    EXPECT_NE(testing::inputErrorMessage([&] { predictor->predict(huge_map); })
+                  .find("the number of cells is 25005000, more than the limit of 25000000"),
+              std::string::npos);
+    EXPECT_NE(testing::inputErrorMessage([&] { predictor->predict(doors_on_a_large_map); })
+                  .find("doors x map cells is 1600000000"),
+              std::string::npos);
+  }
 }
 
 TEST(Prediction, InsertionFillsTheRoomAndOpensItsDoor) {

@@ -227,6 +227,32 @@ class BatchAnalysisTest(unittest.TestCase):
             self.assertIn(message, result.stderr, arguments)
             self.assertFalse(os.path.isfile(os.path.join(out_dir, "results.csv")), arguments)
 
+    def test_bad_parameters_name_the_users_file_and_leave_the_folder_resumable(self):
+        out_dir = os.path.join(self.folder, "bad_params")
+        params = os.path.join(self.folder, "params.yaml")
+        with open(params, "w") as stream:
+            stream.write("start_serach_radius: 2\n")
+        arguments = ["--env", SMALL_WORLD, "--batches", "1", "--max-closed", "1", "--methods", "unstructured",
+                     "--out", out_dir, "--binary", self.binary, "--params", params]
+        result = run_batch(*arguments)
+        self.assertEqual(result.returncode, 2, result.stdout + result.stderr)
+        self.assertIn("%s: unknown parameter 'start_serach_radius'" % params, result.stderr)
+        with open(params, "w") as stream:  # fixed: the same folder now runs
+            stream.write("start_search_radius: 2\n")
+        result = run_batch(*arguments)
+        self.assertEqual(result.returncode, 0, result.stdout + result.stderr)
+
+    def test_the_task_folders_of_killed_runs_are_removed(self):
+        child = subprocess.Popen(["true"])
+        child.wait()
+        stale = os.path.join(tempfile.gettempdir(), "%s%d_abc" % (batch_analysis.TASK_FOLDER_PREFIX, child.pid))
+        os.makedirs(stale, exist_ok=True)
+        mine = tempfile.mkdtemp(prefix="%s%d_" % (batch_analysis.TASK_FOLDER_PREFIX, os.getpid()))
+        batch_analysis.remove_stale_task_folders()
+        self.assertFalse(os.path.exists(stale))
+        self.assertTrue(os.path.isdir(mine))
+        os.rmdir(mine)
+
 
 class SharedEnvironmentTest(unittest.TestCase):
     """One short batch on a thesis environment of the shared data (skips when it is absent)."""

@@ -183,5 +183,17 @@ class DocumentPaths(DocumentTest):
         self.check(problems)
 
 
+class DocumentedLimits(DocumentTest):
+    def test_the_limits_table_gives_the_values_of_the_code(self):
+        """docs/file_formats.md#limits lists every constant of input_limits.h with its value."""
+        header = read(os.path.join("include", "hidden_rooms", "common", "input_limits.h"))
+        code = {name: float(value) for name, value in
+                re.findall(r"constexpr (?:double|int) (kMax\w+) = ([0-9.e]+);", header)}
+        table = {name: float(value) for name, value in
+                 re.findall(r"^\| `(kMax\w+)` \| ([0-9.e]+) \|", read(os.path.join("docs", "file_formats.md")), re.M)}
+        self.assertGreaterEqual(len(code), 5)
+        self.assertEqual(table, code)
+
+
 if __name__ == "__main__":
     unittest.main()

@@ -8,6 +8,7 @@
 #include <visualization_msgs/MarkerArray.h>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -266,6 +267,24 @@ TEST(RoomPredictor, BadRequestsFailWithAMessageAndTheNodeKeepsServing) {
     service.request.map.info.resolution = 0.05f;
     service.request.map.data.resize(7);
     expectFailure(&service, {"map", "7 cells"});
+  }
+  {
+    SCOPED_TRACE("cell values beyond -1..100, a zero or NaN orientation (before: success with no door placed)");
+    const hidden_rooms::common::OccupancyGrid map = hidden_rooms::common::loadMap(caseDir() + "/map.yaml");
+    for (const int8_t value : {int8_t(127), int8_t(-50)}) {
+      PredictRooms service;
+      service.request.doors = hidden_rooms::toRos(doors);
+      service.request.map = hidden_rooms::toRos(map, "map", ros::Time::now());
+      std::replace(service.request.map.data.begin(), service.request.map.data.end(), int8_t(0), value);
+      expectFailure(&service, {"map message", "is " + std::to_string(value), "-1 unknown or 0..100"});
+    }
+    for (const double w : {0.0, std::numeric_limits<double>::quiet_NaN()}) {
+      PredictRooms service;
+      service.request.doors = hidden_rooms::toRos(doors);
+      service.request.map = hidden_rooms::toRos(map, "map", ros::Time::now());
+      service.request.map.info.origin.orientation.w = w;
+      expectFailure(&service, {"map message", "not a unit quaternion"});
+    }
   }
   {
     SCOPED_TRACE("unknown method");

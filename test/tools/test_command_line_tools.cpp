@@ -3,9 +3,14 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <array>
+#include <cctype>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <map>
+#include <random>
 
 #include <opencv2/imgcodecs.hpp>
 
@@ -21,6 +26,8 @@ using testing::runCommand;
 const std::string kRender = RENDER_ENVIRONMENT_BIN;
 const std::string kGenerate = GENERATE_WORLD_BIN;
 const std::string kPredict = PREDICT_ROOMS_OFFLINE_BIN;
+const std::string kExport = EXPORT_OCTOMAP_BIN;
+const std::string kSlice = SLICE_OCTOMAP_BIN;
 
 std::string writeSynthetic(const std::string& dir, const std::string& xml) {
   const std::string path = dir + "/world.xml";
@@ -234,7 +241,191 @@ TEST(PredictRoomsOfflineTool, BadInputGivesAClearErrorAndWritesNothing) {
   expectBadInput(kPredict + " --map " + input + "/map.yaml --doors " + dir + "/bad_doors.yaml --out " + dir +
                      "/out --method unstructured", "not finite");
   expectBadInput(base, "--method");
+  cv::imwrite(dir + "/colour_truth.png", cv::Mat3b::zeros(60, 200));
+  expectBadInput(base + " --method unstructured --gt-rooms " + dir + "/colour_truth.png", "a label image is grey");
   EXPECT_FALSE(std::filesystem::exists(dir + "/out"));
+  // An --out that holds the input map: refused before anything is replaced.
+  const std::string map_before = testing::readFile(input + "/map.pgm");
+  expectBadInput(kPredict + " --map " + input + "/map.yaml --doors " + input + "/doors.yaml --method unstructured" +
+                     " --out " + input,
+                 "would replace the input");
+  EXPECT_EQ(testing::readFile(input + "/map.pgm"), map_before);
+  EXPECT_EQ(testing::fileNames(input), (std::vector<std::string>{"doors.yaml", "map.pgm", "map.yaml", "truth.png"}));
+  // A blocked output name (map.pgm a folder): nothing is moved into place.
+  std::filesystem::create_directories(dir + "/blocked/map.pgm");
+  expectBadInput(kPredict + " --map " + input + "/map.yaml --doors " + input + "/doors.yaml --method unstructured" +
+                     " --out " + dir + "/blocked",
+                 "map.pgm: is a folder");
+  EXPECT_EQ(testing::fileNames(dir + "/blocked"), std::vector<std::string>{"map.pgm"});
+}
+
+// Oversized inputs, each tool run with its address space limited to 2 GB: exit 2 and a message naming the limit
+// (before, an image declaring 1e10 pixels aborted the map readers, --height 100 took 23 GB, 5000 doors 4.8 GB).
+TEST(Tools, OversizedInputsAreRefusedWithinTwoGigabytes) {
+  const std::string dir = testing::makeTempDir("tools_oversized");
+  const std::string input = syntheticCase(dir);
+#ifdef __SANITIZE_ADDRESS__
+  const std::string limited;  // AddressSanitizer reserves terabytes of address space for its shadow memory
+#else
+  const std::string limited = "ulimit -v 2000000; ";
+#endif
+  // 45 bytes of PNG declaring 100000 x 100000 pixels, as a map and as true rooms.
+  const unsigned char png[] = {0x89, 'P',  'N',  'G',  0x0d, 0x0a, 0x1a, 0x0a, 0x00, 0x00, 0x00, 0x0d, 'I',  'H',  'D',
+                               'R',  0x00, 0x01, 0x86, 0xa0, 0x00, 0x01, 0x86, 0xa0, 0x08, 0x00, 0x00, 0x00, 0x00, 0x8d,
+                               0x39, 0x54, 0x14, 0x00, 0x00, 0x00, 0x00, 'I',  'D',  'A',  'T',  0x35, 0xaf, 0x06, 0x1e};
+  std::ofstream(dir + "/huge.png", std::ios::binary).write(reinterpret_cast<const char*>(png), sizeof(png));
+  std::ofstream(dir + "/huge.yaml") << "image: huge.png\nresolution: 0.05\norigin: [0, 0, 0]\nnegate: 0\n"
+                                       "occupied_thresh: 0.65\nfree_thresh: 0.196\n";
+  std::ofstream crowd(dir + "/crowd.yaml");
+  crowd << "frame: map\ndoors:\n";
+  for (int id = 1; id <= 5000; ++id) crowd << "- {id: " << id << ", position: [1, 1], width: 0.9, orientation: O}\n";
+  crowd.close();
+  const std::string out = " --out " + dir + "/out";
+  const std::string pixels = "more than the limit of 25000000 pixels";
+  for (const std::string method : {"default", "thesis"}) {
+    const std::string predict = limited + kPredict + " --method " + method + out;
+    expectBadInput(predict + " --map " + dir + "/huge.yaml --doors " + input + "/doors.yaml", pixels);
+    expectBadInput(predict + " --map " + input + "/map.yaml --doors " + dir + "/crowd.yaml",
+                   "the number of doors is 5000, more than the limit of 500");
+    expectBadInput(predict + " --map " + input + "/map.yaml --doors " + input + "/doors.yaml --gt-rooms " + dir +
+                       "/huge.png",
+                   pixels);
+  }
+  expectBadInput(limited + kExport + " " + dir + "/huge.yaml --out " + dir + "/out/map.bt", pixels);
+  for (const std::string height : {"100000", "1e9"})
+    expectBadInput(limited + kExport + " " + input + "/map.yaml --height " + height + " --out " + dir + "/out/map.bt",
+                   "more than the limit of 200000000: lower --height");
+  ASSERT_EQ(runCommand(kExport + " " + input + "/map.yaml --out " + dir + "/tree/map.bt").exit_code, 0);
+  expectBadInput(limited + kSlice + " " + dir + "/tree/map.bt --resolution 0.0001" + out + "/map.yaml",
+                 "more than the limit of 25000000: slice it at a coarser resolution");
+  expectBadInput(limited + kRender + " " + HIDDEN_ROOMS_SOURCE_DIR + "/worlds/large_2.xml --resolution 0.001" + out,
+                 "the map's number of cells is");
+  EXPECT_FALSE(std::filesystem::exists(dir + "/out"));
+}
+
+// One random corruption of a file's text: bytes flipped or inserted, the text cut, a number replaced by an extreme
+// value, a line deleted or repeated.
+std::string corrupted(const std::string& text, std::mt19937* random) {
+  std::string result = text;
+  const auto position = [&](size_t size) { return std::uniform_int_distribution<size_t>(0, size)(*random); };
+  const auto byte = [&] { return static_cast<char>(std::uniform_int_distribution<int>(0, 255)(*random)); };
+  switch (std::uniform_int_distribution<int>(0, 5)(*random)) {
+    case 0:
+      for (int k = std::uniform_int_distribution<int>(1, 8)(*random); k > 0 && !result.empty(); --k)
+        result[position(result.size() - 1)] = byte();
+      break;
+    case 1:
+      result.resize(position(result.size()));
+      break;
+    case 2:
+      result.insert(position(result.size()), std::string(std::uniform_int_distribution<int>(1, 16)(*random), byte()));
+      break;
+    case 3: {  // a number replaced by an extreme value
+      static const std::vector<std::string> extremes{"1e308", "-1e308", "nan", "inf", "-0", "0", "4294967296",
+                                                     "-7",    "1e-300", "99999999999999999999"};
+      std::vector<size_t> numbers;
+      for (size_t i = 0; i < result.size(); ++i)
+        if (std::isdigit(static_cast<unsigned char>(result[i])) && (i == 0 || !std::isalnum(static_cast<unsigned char>(result[i - 1]))))
+          numbers.push_back(i);
+      if (numbers.empty()) break;
+      const size_t start = numbers[position(numbers.size() - 1)];
+      size_t end = start;
+      while (end < result.size() && (std::isalnum(static_cast<unsigned char>(result[end])) || result[end] == '.')) ++end;
+      result.replace(start, end - start, extremes[position(extremes.size() - 1)]);
+      break;
+    }
+    default: {  // a line deleted (4) or repeated (5)
+      std::vector<size_t> starts{0};
+      for (size_t i = 0; i + 1 < result.size(); ++i)
+        if (result[i] == '\n') starts.push_back(i + 1);
+      const size_t line = position(starts.size() - 1);
+      const size_t begin = starts[line], end = line + 1 < starts.size() ? starts[line + 1] : result.size();
+      const std::string text_of_line = result.substr(begin, end - begin);
+      if (result.size() > 0 && std::uniform_int_distribution<int>(0, 1)(*random) == 0)
+        result.erase(begin, end - begin);
+      else
+        result.insert(begin, text_of_line);
+    }
+  }
+  return result;
+}
+
+// A few hundred seeded random corruptions of good inputs, each fed to a command-line tool with its address space
+// limited to 2 GB: the tool exits 0 or 2, on exit 2 with exactly one line on stderr and no output left behind.
+TEST(Tools, RandomCorruptionsOfGoodInputsExitZeroOrTwoWithOneLineAndNoPartialOutput) {
+  const std::string dir = testing::makeTempDir("tools_corruptions");
+  const std::string input = syntheticCase(dir);
+  ASSERT_EQ(runCommand(kPredict + " --map " + input + "/map.yaml --doors " + input + "/doors.yaml --method default" +
+                       " --out " + dir + "/prediction").exit_code, 0);
+  ASSERT_EQ(runCommand(kExport + " " + input + "/map.yaml --out " + dir + "/tree.bt").exit_code, 0);
+  const std::string world = dir + "/world.xml";
+  std::ofstream(world) << testing::corridorWithTwoRoomsXml();
+  std::ofstream(dir + "/params.yaml") << "start_search_radius: 1.5\nwall_margin: 2\n";
+
+  struct Target {
+    std::string tool, file;                  // the tool and the input file corrupted (a copy of it)
+    std::function<std::string(const std::string&)> command;  // the command line, given the corrupted copy's path
+    std::string output;                      // what the tool writes (must be absent after exit 2)
+  };
+  const std::string out = dir + "/out";
+  const std::string case_files = " --doors " + input + "/doors.yaml --out " + out;
+  const std::vector<Target> targets{
+      {"predict map.yaml", input + "/map.yaml",
+       [&](const std::string& f) { return kPredict + " --method default --map " + f + case_files; }, out},
+      {"predict map.pgm", input + "/map.pgm",
+       [&](const std::string& f) {
+         std::ofstream(dir + "/c/map.yaml") << "image: " + f + "\nresolution: 0.05\norigin: [0, 0, 0]\nnegate: 0\n"
+                                               "occupied_thresh: 0.65\nfree_thresh: 0.196\n";
+         return kPredict + " --method thesis --map " + dir + "/c/map.yaml" + case_files;
+       },
+       out},
+      {"predict doors.yaml", input + "/doors.yaml",
+       [&](const std::string& f) {
+         return kPredict + " --method default --map " + input + "/map.yaml --doors " + f + " --out " + out;
+       },
+       out},
+      {"predict params", dir + "/params.yaml",
+       [&](const std::string& f) { return kPredict + " --method structured --map " + input + "/map.yaml --params " + f + case_files; },
+       out},
+      {"export rooms.yaml", dir + "/prediction/rooms.yaml",
+       [&](const std::string& f) { return kExport + " " + input + "/map.yaml --rooms " + f + " --out " + out + ".ot"; },
+       out + ".ot"},
+      {"slice tree.bt", dir + "/tree.bt",
+       [&](const std::string& f) { return kSlice + " " + f + " --out " + out + "/map.yaml"; }, out},
+      {"render world.xml", world,
+       [&](const std::string& f) { return kRender + " " + f + " --closed all --hide-closed-rooms --out " + out; }, out},
+  };
+#ifdef __SANITIZE_ADDRESS__
+  const std::string limited;  // AddressSanitizer reserves terabytes of address space for its shadow memory
+#else
+  const std::string limited = "ulimit -v 2000000; ";
+#endif
+  constexpr int kPerTarget = 40;
+  std::mt19937 random(20261203);
+  std::map<std::string, std::array<int, 2>> handled;  // exits 0 and 2 per target
+  std::filesystem::create_directories(dir + "/c");
+  std::filesystem::copy_file(input + "/map.pgm", dir + "/c/map.pgm");  // the image of the corrupted map.yaml copies
+  for (const Target& target : targets) {
+    const std::string original = testing::readFile(target.file);
+    ASSERT_FALSE(original.empty()) << target.file;
+    const std::string copy = dir + "/c/" + std::filesystem::path(target.file).filename().string();
+    for (int k = 0; k < kPerTarget; ++k) {
+      std::ofstream(copy, std::ios::binary) << corrupted(original, &random);
+      std::filesystem::remove_all(target.output);
+      const std::string command = target.command(copy);
+      const auto result = runCommand("{ (" + limited + command + ") 2>&1 >/dev/null; }");  // stderr only
+      const std::string context = target.tool + " #" + std::to_string(k) + ": " + command + "\n" + result.output;
+      ASSERT_TRUE(result.exit_code == 0 || result.exit_code == 2) << context;
+      if (result.exit_code == 2) {
+        EXPECT_EQ(std::count(result.output.begin(), result.output.end(), '\n'), 1) << context;
+        EXPECT_FALSE(std::filesystem::exists(target.output)) << context;
+      }
+      ++handled[target.tool][result.exit_code == 0 ? 0 : 1];
+    }
+  }
+  for (const auto& [tool, counts] : handled)
+    std::printf("%-20s %d corruptions: exit 0 %d, exit 2 %d\n", tool.c_str(), counts[0] + counts[1], counts[0],
+                counts[1]);
 }
 
 TEST(Tools, HelpExitsZero) {

@@ -138,6 +138,11 @@ TEST(Environment, SelectsDoorsByNumberIdOrAll) {
   EXPECT_EQ(parseDoorSelection(environment, "all", "x"), (std::set<int>{0, 1}));
   EXPECT_EQ(parseDoorSelection(environment, "2, door_a", "x"), (std::set<int>{0, 1}));
   EXPECT_THROW(parseDoorSelection(environment, "3", "x"), common::InputError);
+  for (const char* spec : {"1,,2", ",1", "1,", " , "})  // an empty item: a typo, not "no door"
+    EXPECT_NE(testing::inputErrorMessage([&] { parseDoorSelection(environment, spec, "--closed"); })
+                  .find("has an empty door number"),
+              std::string::npos)
+        << spec;
 }
 
 // Bad input: each error names the input and the problem.

@@ -263,7 +263,9 @@ TEST(WorldGeneratorTool, RejectsBadCommandLines) {
   EXPECT_NE(output.find("unknown size class 'huge'"), std::string::npos) << output;
   EXPECT_EQ(runCommand(binary + " --seed minus --size small --out " + dir + "/a.xml", &output), 2) << output;
   EXPECT_EQ(runCommand(binary + " --seed -3 --size small --out " + dir + "/a.xml", &output), 2) << output;
-  EXPECT_EQ(runCommand(binary + " --seed 5 --size small --out " + dir + "/missing/a.xml", &output), 2) << output;
+  std::ofstream(dir + "/plain_file") << "x";
+  EXPECT_EQ(runCommand(binary + " --seed 5 --size small --out " + dir + "/plain_file/a.xml", &output), 2) << output;
+  EXPECT_EQ(runCommand(binary + " --seed 5 --size small --out " + dir + "/new/a.xml", &output), 0) << output;
   EXPECT_EQ(runCommand(binary + " --help", &output), 0) << output;
 }
 

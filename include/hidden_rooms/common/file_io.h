@@ -5,6 +5,7 @@
 
 #include <functional>
 #include <string>
+#include <vector>
 
 #include <yaml-cpp/yaml.h>
 
@@ -23,5 +24,37 @@ void writeTextAtomically(const std::string& path, const std::string& text, const
 
 // Creates an output folder (and its parents); throws InputError naming it when that is impossible.
 void createOutputDirectory(const std::string& path);
+
+// A tool's output folder, written all or nothing: the files of a run go to a staging folder inside it
+// (OUT/.partialPID) and commit() moves them into OUT, each replacing the previous run's file of that name; an
+// OutputFolder destroyed without commit() (an error) removes its staging folder, so OUT keeps what it held (an OUT it
+// created is removed). The
+// constructor creates OUT and locks it (flock on the folder itself, held until destruction); staging folders
+// of runs that no longer run are removed. Throws InputError naming OUT when it cannot be created, when another run
+// holds its lock, and (file()) when an output would replace one of `inputs`.
+class OutputFolder {
+ public:
+  OutputFolder(const std::string& out, const std::vector<std::string>& inputs);
+  ~OutputFolder();
+  OutputFolder(const OutputFolder&) = delete;
+  OutputFolder& operator=(const OutputFolder&) = delete;
+
+  // Where this run writes its output file `name` (a plain file name) until commit().
+  std::string file(const std::string& name) const;
+  // The prefix to give saveMap for the map STEM.yaml + STEM`image_extension`, checked like file().
+  std::string mapPrefix(const std::string& stem, const std::string& image_extension = ".pgm") const;
+  // Moves every staged file into OUT. Checks first that each can replace what OUT holds under its name (not a
+  // folder), so that a blocked name leaves OUT as it was.
+  void commit();
+  const std::string& path() const { return out_; }
+
+ private:
+  std::string out_;
+  std::string staging_;
+  std::vector<std::string> inputs_;  // canonical paths
+  int lock_fd_ = -1;
+  bool created_ = false;  // OUT did not exist before: removed again when nothing was committed
+  bool committed_ = false;
+};
 
 }  // namespace hidden_rooms::common

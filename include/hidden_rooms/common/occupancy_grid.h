@@ -29,7 +29,7 @@ struct OccupancyGrid {
   Point2 cellCentre(int col, int row) const;
   // Continuous image coordinates (col, row, cells spanning [c, c+1)) of a map-frame point.
   Point2 toImage(const Point2& point) const;
-  // The cell containing a map-frame point; false when it lies outside the grid.
+  // The cell containing a map-frame point (a point on the grid's far edges: the edge cell); false outside the grid.
   bool cellOf(const Point2& point, int* col, int* row) const;
 
   // Greyscale rendering as map_server images use it: 254 free, 0 occupied, 205 unknown, intermediate
@@ -55,6 +55,8 @@ struct MapMetadata {
 // Loads a map_server map (yaml + image) with map_server's semantics (trinary, scale and raw modes, negate,
 // thresholds, origin). Only yaw 0 is supported. Throws InputError naming the file and the problem.
 OccupancyGrid loadMap(const std::string& yaml_path);
+// The path of the image a map yaml names (resolved against the yaml's folder). Throws InputError like loadMap.
+std::string mapImagePath(const std::string& yaml_path);
 // Converts a greyscale image with map_server's rules.
 OccupancyGrid gridFromImage(const cv::Mat& image, const MapMetadata& metadata);
 

@@ -13,6 +13,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "hidden_rooms/common/file_io.h"
 #include "hidden_rooms/evaluation/evaluation.h"
 #include "hidden_rooms/prediction/room_predictor.h"
 
@@ -23,11 +24,11 @@ struct PredictionOutputs {
   std::optional<RoomScores> scores;  // set when true rooms were given
 };
 
-// Writes the files above into `out_dir` (created). `true_labels` (same size as the map, same labels) is
-// optional. Throws InputError naming a file that cannot be written.
+// Writes the files above into `out` and commits them (all or nothing). `true_labels` (same size as the map, same
+// labels) is optional. Throws InputError naming a file that cannot be written or would replace an input.
 PredictionOutputs writePredictionOutputs(const prediction::PredictionRequest& request,
                                          const prediction::PredictionResult& result, const std::string& method,
-                                         const std::string& out_dir, const cv::Mat& true_labels = cv::Mat());
+                                         common::OutputFolder* out, const cv::Mat& true_labels = cv::Mat());
 
 // Reads a true rooms label image and checks it has the map's size; throws InputError naming the file.
 cv::Mat loadTrueRooms(const std::string& path, const common::OccupancyGrid& map);

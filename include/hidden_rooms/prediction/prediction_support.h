@@ -35,6 +35,10 @@ RoomPrediction unplacedRoom(const common::OccupancyGrid& map, int door_id, const
 // Throws InputError when the map has no cells, no known cell or no free cell.
 void checkUsableMap(const common::OccupancyGrid& map);
 
+// Every method's first check: a usable map, and the map's cells, the doors and their product within the limits
+// of common/input_limits.h. Throws InputError naming the limit.
+void checkUsableRequest(const PredictionRequest& request);
+
 // For requests from outside (the predict_rooms service): throws InputError("door ID", ...) naming the first
 // door whose position lies outside the map's extent (usually a door given in another frame), and
 // InputError("doors", ...) when two doors share an id.

@@ -11,6 +11,7 @@
 #include <ros/ros.h>
 
 #include "hidden_rooms/common/doors_file.h"
+#include "hidden_rooms/common/input_limits.h"
 #include "hidden_rooms/common/occupancy_grid.h"
 #include "hidden_rooms/common/options.h"
 #include "hidden_rooms/prediction/room_predictor.h"
@@ -32,8 +33,8 @@ struct RoomPredictorOptions {
   std::string octomap_out;         // after each prediction, the completed map extruded to this .ot/.bt; "" = off
   double octomap_height = 2.5;     // metres, height of the extruded walls
   // Requests beyond these are refused (bounded answer times and memory).
-  int max_doors = 500;
-  int max_map_cells = 25000000;    // 5000 x 5000 cells: 250 m x 250 m at 0.05 m
+  int max_doors = common::kMaxDoors;
+  int max_map_cells = static_cast<int>(common::kMaxMapCells);  // 5000 x 5000 cells: 250 m x 250 m at 0.05 m
 };
 
 // The node's parameters, as docs/ros_api.md lists them.
