@@ -15,6 +15,16 @@
 
 namespace hidden_rooms::common {
 
+bool isFile(const std::string& path) {
+  std::error_code error;
+  return std::filesystem::is_regular_file(path, error);
+}
+
+bool isFolder(const std::string& path) {
+  std::error_code error;
+  return std::filesystem::is_directory(path, error);
+}
+
 std::string readTextFile(const std::string& path, const std::string& what) {
   std::ifstream file(path, std::ios::binary);
   if (!file) throw InputError(path, "cannot open " + what);
@@ -91,7 +101,7 @@ void writeTextAtomically(const std::string& path, const std::string& text, const
 void createOutputDirectory(const std::string& path) {
   std::error_code error;
   std::filesystem::create_directories(path, error);
-  if (error || !std::filesystem::is_directory(path))
+  if (error || !isFolder(path))
     throw InputError(path, "cannot create output folder" + (error ? ": " + error.message() : std::string()));
 }
 
@@ -103,7 +113,8 @@ constexpr const char* kStagingPrefix = ".partial";
 
 OutputFolder::OutputFolder(const std::string& out, const std::vector<std::string>& inputs) : out_(out) {
   namespace fs = std::filesystem;
-  created_ = !fs::exists(out);
+  std::error_code missing;
+  created_ = !fs::exists(out, missing);
   createOutputDirectory(out);
   const fs::path folder(out);
   lock_fd_ = open(out.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
@@ -157,7 +168,7 @@ void OutputFolder::commit() {
     staged.push_back(entry->path());
   if (error) throw InputError(out_, "cannot list the staged outputs: " + error.message());
   for (const fs::path& file : staged)
-    if (fs::is_directory(fs::path(out_) / file.filename()))
+    if (isFolder((fs::path(out_) / file.filename()).string()))
       throw InputError((fs::path(out_) / file.filename()).string(), "is a folder: the output of that name cannot "
                                                                      "replace it (nothing was written)");
   for (const fs::path& file : staged) {

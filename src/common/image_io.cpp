@@ -172,8 +172,8 @@ bool writePngRows(std::FILE* file, const PngRows& image, char* error) {
 }  // namespace
 
 cv::Mat readImage(const std::string& path) {
-  if (std::filesystem::is_directory(path)) throw InputError(path, "is a folder, not an image file");
-  if (!std::filesystem::is_regular_file(path)) throw InputError(path, "image file does not exist");
+  if (isFolder(path)) throw InputError(path, "is a folder, not an image file");
+  if (!isFile(path)) throw InputError(path, "image file does not exist");
   std::ifstream file(path, std::ios::binary);
   if (!file) throw InputError(path, "cannot open image file");
   unsigned char head[8] = {0};

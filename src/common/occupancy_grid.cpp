@@ -169,7 +169,7 @@ std::string mapImagePath(const std::string& yaml_path) {
 OccupancyGrid loadMap(const std::string& yaml_path) {
   const MapMetadata metadata = readMetadata(yaml_path);
   const std::filesystem::path image_path = imagePathOf(yaml_path, metadata);
-  if (!std::filesystem::is_regular_file(image_path))
+  if (!isFile(image_path.string()))
     throw InputError(yaml_path, "map image '" + image_path.string() + "' does not exist");
   cv::Mat image;
   try {

@@ -142,6 +142,21 @@ TrajectoryError trajectoryError(const std::vector<common::Pose2>& estimate, cons
     error.position_rmse = std::sqrt(position_sum / n);
     error.yaw_rmse = std::sqrt(yaw_sum / n);
   }
+  // Relations between consecutive poses (Kummerle et al. 2009): the estimated motion against the true one.
+  double translation_sum = 0.0, rotation_sum = 0.0, distance = 0.0;
+  for (size_t i = 1; i < n; ++i) {
+    const common::Pose2 moved = common::composePoses(common::invertPose(estimate[i - 1]), estimate[i]);
+    const common::Pose2 truly = common::composePoses(common::invertPose(truth[i - 1]), truth[i]);
+    translation_sum += std::hypot(moved.x - truly.x, moved.y - truly.y);
+    rotation_sum += std::abs(std::atan2(std::sin(moved.yaw - truly.yaw), std::cos(moved.yaw - truly.yaw)));
+    distance += std::hypot(truly.x, truly.y);
+  }
+  if (n > 1) {
+    error.relations = static_cast<int>(n - 1);
+    error.relative_translation_mean = translation_sum / (n - 1);
+    error.relative_rotation_mean = rotation_sum / (n - 1);
+    error.relative_translation_per_metre = distance > 0.0 ? translation_sum / distance : 0.0;
+  }
   return error;
 }
 

@@ -282,7 +282,7 @@ common::OccupancyGrid sliceOctomap(const std::string& path, const SliceOptions& 
     throw common::InputError("octomap slice", "the band needs z_min < z_max");
   if (!(options.resolution >= 0.0) || !std::isfinite(options.resolution))
     throw common::InputError("octomap slice", "the resolution must be positive (or 0 for the tree's)");
-  if (!std::filesystem::is_regular_file(path)) throw common::InputError(path, "no such file");
+  if (!common::isFile(path)) throw common::InputError(path, "no such file");
   const std::string extension = extensionOf(path);
   if (extension == ".bt") {
     std::istringstream stream = checkedOctomapStream(path, true);

@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <exception>
-#include <filesystem>
 #include <fstream>
 #include <optional>
+#include <sstream>
 
 #include <mrpt/config/CConfigFile.h>
 #include <mrpt/core/format.h>
@@ -21,6 +21,7 @@
 #include <mrpt/random/RandomGenerators.h>
 #include <mrpt/slam/CMetricMapBuilderRBPF.h>
 
+#include "hidden_rooms/common/file_io.h"
 #include "hidden_rooms/common/input_error.h"
 
 namespace hidden_rooms::mapping {
@@ -40,6 +41,17 @@ bool finite(const common::Pose2& pose) {
 }
 
 // The odometry motion model from the ini's [MotionModel] section (MRPT has no loader for it).
+// The line of an MRPT exception that says what went wrong (its text carries a banner and a stack trace).
+std::string mrptMessage(const std::exception& error) {
+  std::istringstream text(error.what());
+  std::string line, first;
+  while (std::getline(text, line)) {
+    if (line.rfind("Message:", 0) == 0) return line.substr(line.find_first_not_of(' ', 8));
+    if (first.empty() && !line.empty() && line.find("====") == std::string::npos) first = line;
+  }
+  return first;
+}
+
 mrpt::obs::CActionRobotMovement2D::TMotionModelOptions readMotionModel(const mrpt::config::CConfigFileBase& ini,
                                                                        const std::string& file) {
   mrpt::obs::CActionRobotMovement2D::TMotionModelOptions model;
@@ -92,6 +104,7 @@ struct RbpfMapper::Impl {
   mrpt::obs::CActionRobotMovement2D::TMotionModelOptions motion_model;
   bool started = false;
   common::Pose2 last_odometry;
+  std::string config_file;
   int added = 0;
   int inserted = 0;
 
@@ -113,7 +126,7 @@ struct RbpfMapper::Impl {
 RbpfMapper::RbpfMapper(const RbpfMapperOptions& options) : impl_(std::make_unique<Impl>()) {
   const std::string& file = options.config_file;
   if (file.empty()) throw common::InputError("rbpf config", "no ini file given");
-  if (!std::filesystem::is_regular_file(file) || !std::ifstream(file).good())
+  if (!common::isFile(file) || !std::ifstream(file).good())
     throw common::InputError(file, "cannot read the file");
   mrpt::slam::CMetricMapBuilderRBPF::TConstructionOptions construction;
   try {
@@ -129,11 +142,7 @@ RbpfMapper::RbpfMapper(const RbpfMapperOptions& options) : impl_(std::make_uniqu
   } catch (const common::InputError&) {
     throw;
   } catch (const std::exception& error) {
-    // MRPT's messages carry a stack trace; its first line names the missing or bad key.
-    std::string message = error.what();
-    const size_t newline = message.find('\n');
-    if (newline != std::string::npos) message = message.substr(0, newline);
-    throw common::InputError(file, "bad MRPT RBPF options: " + message);
+    throw common::InputError(file, "bad MRPT RBPF options: " + mrptMessage(error));
   }
   if (construction.PF_options.sampleSize == 0) throw common::InputError(file, "sampleSize must be positive");
   if (!(construction.insertionLinDistance >= 0.0f) || !(construction.localizeLinDistance >= 0.0f))
@@ -142,9 +151,9 @@ RbpfMapper::RbpfMapper(const RbpfMapperOptions& options) : impl_(std::make_uniqu
   try {
     impl_->builder = std::make_unique<mrpt::slam::CMetricMapBuilderRBPF>(construction);
   } catch (const std::exception& error) {
-    std::string message = error.what();
-    throw common::InputError(file, "MRPT cannot build the filter: " + message.substr(0, message.find('\n')));
+    throw common::InputError(file, "MRPT cannot build the filter: " + mrptMessage(error));
   }
+  impl_->config_file = file;
   const mrpt::maps::CMultiMetricMap* maps = impl_->builder->getCurrentlyBuiltMetricMap();
   if (maps == nullptr || maps->countMapsByClass<mrpt::maps::COccupancyGridMap2D>() == 0)
     throw common::InputError(file, "the maps must include an occupancy grid (occupancyGrid_count = 1)");
@@ -200,7 +209,11 @@ bool RbpfMapper::addScan(const common::Pose2& odometry, const mrpt::obs::CObserv
   actions.insert(movement);
   impl.last_odometry = odometry;
 
-  impl.builder->processActionObservation(actions, frame);
+  try {
+    impl.builder->processActionObservation(actions, frame);
+  } catch (const std::exception& error) {  // options that do not fit together (an ICP method for another map type)
+    throw common::InputError(impl.config_file, "MRPT rejects these options while mapping: " + mrptMessage(error));
+  }
   ++impl.added;
   const bool was_inserted = impl.builder->m_statsLastIteration.observationsInserted;
   impl.inserted += was_inserted;

@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "hidden_rooms/common/image_io.h"
+#include "hidden_rooms/common/file_io.h"
 #include "hidden_rooms/common/input_error.h"
 
 namespace hidden_rooms::prediction {
@@ -226,9 +227,7 @@ const std::vector<std::string>& layoutDebugImageNames() {
 void writeLayoutDebugImages(const std::string& dir, const common::OccupancyGrid& map,
                             const std::vector<common::MapDoor>& closed_doors, const cv::Mat1b& grey,
                             const cv::Mat1b& edges, const cv::Mat1b& explored, const Layout& layout) {
-  std::error_code error;
-  std::filesystem::create_directories(dir, error);
-  if (!std::filesystem::is_directory(dir)) throw common::InputError(dir, "cannot create debug folder");
+  common::createOutputDirectory(dir);
 
   const DebugCanvas canvas(layout, grey);
   const std::vector<cv::Mat> images{edges,

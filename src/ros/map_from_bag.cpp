@@ -1,5 +1,6 @@
 // map_from_bag BAG --out PREFIX: the mapper's SLAM straight from a bag's scans and tf, as fast as the CPU allows
-// (rosbag C++ API, no roscore). Optionally scores the map against an environment's rendered ground truth.
+// (rosbag C++ API, no roscore). Optionally scores the map against an environment's rendered ground truth or a
+// reference map.
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -22,6 +23,8 @@
 #include "hidden_rooms/common/file_io.h"
 #include "hidden_rooms/common/image_io.h"
 #include "hidden_rooms/common/input_error.h"
+#include "hidden_rooms/common/pose_log.h"
+#include "hidden_rooms/evaluation/door_translation.h"
 #include "hidden_rooms/evaluation/map_quality.h"
 #include "hidden_rooms/mapping/rbpf_mapper.h"
 #include "hidden_rooms/ros/conversions.h"
@@ -32,29 +35,14 @@
 namespace po = boost::program_options;
 using hidden_rooms::common::InputError;
 using hidden_rooms::common::Pose2;
+using hidden_rooms::common::TimedPose;
+using hidden_rooms::common::poseAt;
 
 namespace {
 
 using Clock = std::chrono::steady_clock;
+constexpr double kMountWait = 1.0;  // seconds of bag time a scan waits for its laser mount
 double seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
-
-struct TimedPose {
-  double time = 0.0;
-  Pose2 pose;
-};
-
-// The pose at `time` interpolated between recorded poses (clamped at the ends).
-Pose2 interpolate(const std::vector<TimedPose>& poses, double time) {
-  auto after = std::lower_bound(poses.begin(), poses.end(), time,
-                                [](const TimedPose& p, double t) { return p.time < t; });
-  if (after == poses.begin()) return poses.front().pose;
-  if (after == poses.end()) return poses.back().pose;
-  const TimedPose& a = *(after - 1);
-  const TimedPose& b = *after;
-  const double f = b.time > a.time ? (time - a.time) / (b.time - a.time) : 0.0;
-  const double dyaw = std::atan2(std::sin(b.pose.yaw - a.pose.yaw), std::cos(b.pose.yaw - a.pose.yaw));
-  return {a.pose.x + f * (b.pose.x - a.pose.x), a.pose.y + f * (b.pose.y - a.pose.y), a.pose.yaw + f * dyaw};
-}
 
 // A topic or frame name without its leading slashes: older bags and drivers write "/base_scan" and "/base_link"
 // where newer ones write "base_scan" and "base_link"; tf2 takes frame ids without one.
@@ -78,7 +66,8 @@ std::string defaultConfig() {
 }
 
 int run(int argc, char** argv) {
-  std::string bag_path, prefix, config, scan_topic, odom_frame, base_frame, environment_path, closed, metrics_path,
+  std::string bag_path, prefix, config, scan_topic, odom_frame, base_frame, environment_path, reference_path, closed,
+      metrics_path,
       truth_topic, comparison_path, odom_topic;
   int seed = 0;
   bool quiet = false;
@@ -94,12 +83,14 @@ int run(int argc, char** argv) {
       ("odom-topic", po::value(&odom_topic),
        "nav_msgs/Odometry topic to take the odometry from, for bags without odom -> base_link in /tf")
       ("environment", po::value(&environment_path), "score the map against this environment XML's rendering")
+      ("reference-map", po::value(&reference_path),
+       "score the map against this map, in the frame of the true poses (carmen_to_bag --reference-map)")
       ("closed-doors", po::value(&closed)->default_value(""), "with --environment: doors closed in the run")
       ("truth-topic", po::value(&truth_topic)->default_value("base_pose_ground_truth"),
        "with --environment: nav_msgs/Odometry of the true pose in the world frame")
-      ("metrics", po::value(&metrics_path), "with --environment: also write the figures to this YAML file")
+      ("metrics", po::value(&metrics_path), "when scoring: also write the figures to this YAML file")
       ("comparison", po::value(&comparison_path),
-       "with --environment: PNG of the map on the truth (white: both free; orange / red / magenta: observed free the "
+       "when scoring: PNG of the map on the truth (white: both free; orange / red / magenta: observed free the "
        "map has unknown / uncertain / occupied; blue: map free where the truth is not observed free)")
       ("quiet", po::bool_switch(&quiet), "no progress line");
   po::positional_options_description positional;
@@ -107,25 +98,32 @@ int run(int argc, char** argv) {
   po::variables_map values;
   if (!hidden_rooms::common::parseCommandLine(
           argc, argv,
-          "Usage: map_from_bag BAG --out PREFIX [--config rbpf.ini] [--seed N] [--environment ENV.xml [--metrics "
-          "F.yaml]]\n"
+          "Usage: map_from_bag BAG --out PREFIX [--config rbpf.ini] [--seed N]\n"
+          "                    [--environment ENV.xml | --reference-map MAP.yaml] [--metrics F.yaml]\n"
           "Builds the mapper's map (MRPT RBPF) from the bag's scans and tf odom -> base_link (or --odom-topic), as\n"
-          "fast as the CPU allows, and writes it as map_server files. With --environment also prints map quality and trajectory\n"
-          "error against the rendered ground truth (true poses from --truth-topic).",
+          "fast as the CPU allows, and writes it as map_server files. With --environment or --reference-map also\n"
+          "prints map quality and trajectory errors (absolute after a rigid fit, and relative between consecutive\n"
+          "scans) against the rendered ground truth or the reference map (true poses from --truth-topic).",
           options, positional, &values))
     return hidden_rooms::common::kExitOk;
   if (seed < 0) throw InputError("--seed", "must be zero or positive");
   if (config.empty()) config = defaultConfig();
   if (config.empty()) throw InputError("--config", "not given and the package's config/rbpf.ini was not found");
-  if (!metrics_path.empty() && environment_path.empty()) throw InputError("--metrics", "needs --environment");
-  if (!comparison_path.empty() && environment_path.empty()) throw InputError("--comparison", "needs --environment");
+  if (!environment_path.empty() && !reference_path.empty())
+    throw InputError("--reference-map", "give --environment or --reference-map, not both");
+  const bool scoring = !environment_path.empty() || !reference_path.empty();
+  if (!metrics_path.empty() && !scoring) throw InputError("--metrics", "needs --environment or --reference-map");
+  if (!comparison_path.empty() && !scoring) throw InputError("--comparison", "needs --environment or --reference-map");
 
   // Inputs first: nothing is written on bad input.
-  hidden_rooms::world::RenderedEnvironment truth;
+  hidden_rooms::common::OccupancyGrid truth_map;  // in the frame of the true poses
   if (!environment_path.empty()) {
     const hidden_rooms::world::Environment environment = hidden_rooms::world::loadEnvironment(environment_path);
-    truth = hidden_rooms::world::renderEnvironment(
-        environment, hidden_rooms::world::parseDoorSelection(environment, closed, "--closed-doors"));
+    truth_map = hidden_rooms::world::renderEnvironment(
+                    environment, hidden_rooms::world::parseDoorSelection(environment, closed, "--closed-doors"))
+                    .map;
+  } else if (!reference_path.empty()) {
+    truth_map = hidden_rooms::common::loadMap(reference_path);
   }
   hidden_rooms::mapping::RbpfMapperOptions mapper_options;
   mapper_options.config_file = config;
@@ -193,23 +191,28 @@ int run(int argc, char** argv) {
       last_mount_error = error.what();
       return;
     }
-    try {
-      const Pose2 odometry =
-          hidden_rooms::fromRos(tf_buffer.lookupTransform(odom_frame, base_frame, scan.header.stamp).transform);
-      const sensor_msgs::LaserScan upright = hidden_rooms::uprightScan(scan, mount);
-      const bool inserted = mapper.addScan(odometry, hidden_rooms::toMrptScan(upright, mount.pose));
-      ++processed;
-      if (!environment_path.empty()) {
-        scan_times.push_back(scan.header.stamp.toSec());
-        estimate.push_back(mapper.pose());
-        if (inserted) inserted_scans.emplace_back(scan.header.stamp.toSec(), hidden_rooms::fromRos(upright, mount.pose));
-      }
+    Pose2 odometry;
+    sensor_msgs::LaserScan upright;
+    mrpt::obs::CObservation2DRangeScan observation;
+    try {  // a scan without odometry at its stamp, or with bad geometry, is dropped; the mapper's errors are not
+      odometry = hidden_rooms::fromRos(tf_buffer.lookupTransform(odom_frame, base_frame, scan.header.stamp).transform);
+      upright = hidden_rooms::uprightScan(scan, mount);
+      observation = hidden_rooms::toMrptScan(upright, mount.pose);
     } catch (const tf2::TransformException& error) {
       ++dropped;
       last_tf_error = error.what();
+      return;
     } catch (const InputError& error) {
       ++dropped;
       last_tf_error = error.what();
+      return;
+    }
+    const bool inserted = mapper.addScan(odometry, observation);
+    ++processed;
+    if (scoring) {
+      scan_times.push_back(scan.header.stamp.toSec());
+      estimate.push_back(mapper.pose());
+      if (inserted) inserted_scans.emplace_back(scan.header.stamp.toSec(), hidden_rooms::fromRos(upright, mount.pose));
     }
   };
 
@@ -240,8 +243,14 @@ int run(int argc, char** argv) {
       if (topic == truth_topic)
         true_poses.push_back({odometry->header.stamp.toSec(), hidden_rooms::fromRos(odometry->pose.pose)});
     }
-    // A scan is processed once the odometry after its stamp is in the buffer (tf at the scan's time).
-    while (!pending.empty() && tf_buffer.canTransform(odom_frame, base_frame, pending.front()->header.stamp)) {
+    // A scan is processed once the odometry after its stamp is in the buffer (tf at the scan's time) and the laser
+    // mount is known; the mount (/tf_static, often stamped like the first scan) is awaited up to kMountWait seconds.
+    const auto ready = [&](const sensor_msgs::LaserScan& scan) {
+      if (!tf_buffer.canTransform(odom_frame, base_frame, scan.header.stamp)) return false;
+      return tf_buffer.canTransform(base_frame, withoutLeadingSlash(scan.header.frame_id), ros::Time(0)) ||
+             message.getTime().toSec() - scan.header.stamp.toSec() > kMountWait;
+    };
+    while (!pending.empty() && ready(*pending.front())) {
       process(*pending.front());
       pending.pop_front();
     }
@@ -277,34 +286,40 @@ int run(int argc, char** argv) {
               "wall_seconds: %.2f\nspeed_factor: %.1f\n",
               bag_path.c_str(), yaml.c_str(), processed, mapper.scansInserted(), dropped, bag_seconds, wall_seconds,
               bag_seconds / std::max(wall_seconds, 1e-9));
-  if (environment_path.empty()) return hidden_rooms::common::kExitOk;
+  if (!scoring) return hidden_rooms::common::kExitOk;
 
   if (true_poses.empty()) throw InputError(bag_path, "no nav_msgs/Odometry on " + truth_topic + " to score against");
-  std::sort(true_poses.begin(), true_poses.end(), [](const TimedPose& a, const TimedPose& b) { return a.time < b.time; });
+  std::sort(true_poses.begin(), true_poses.end(),
+            [](const TimedPose& a, const TimedPose& b) { return a.time < b.time; });
   std::vector<Pose2> truth_at_scans;
-  for (double t : scan_times) truth_at_scans.push_back(interpolate(true_poses, t));
-  const Pose2 world_from_map =
-      hidden_rooms::common::composePoses(truth_at_scans.back(), hidden_rooms::common::invertPose(estimate.back()));
+  for (double t : scan_times) truth_at_scans.push_back(poseAt(true_poses, t));
+  // The map placed in the truth's frame by the least-squares rigid fit of the whole trajectory.
+  std::vector<TimedPose> estimated;
+  for (size_t k = 0; k < scan_times.size(); ++k) estimated.push_back({scan_times[k], estimate[k]});
+  const Pose2 world_from_map = hidden_rooms::evaluation::fitWorldFromMap(true_poses, estimated);
   cv::Mat1b observed;
   for (const auto& [time, scan] : inserted_scans)
     hidden_rooms::evaluation::markObservedCells(
-        truth.map, hidden_rooms::common::composePoses(interpolate(true_poses, time), scan.sensor_pose), scan,
-        &observed);
+        truth_map, hidden_rooms::common::composePoses(poseAt(true_poses, time), scan.sensor_pose), scan, &observed);
   const hidden_rooms::evaluation::MapQuality quality =
-      hidden_rooms::evaluation::evaluateMap(map, world_from_map, truth.map, observed);
+      hidden_rooms::evaluation::evaluateMap(map, world_from_map, truth_map, observed);
   if (!comparison_path.empty())
     hidden_rooms::common::writeImage(
-        comparison_path, hidden_rooms::evaluation::drawMapComparison(map, world_from_map, truth.map, observed));
+        comparison_path, hidden_rooms::evaluation::drawMapComparison(map, world_from_map, truth_map, observed));
   const hidden_rooms::evaluation::TrajectoryError trajectory =
       hidden_rooms::evaluation::trajectoryError(estimate, truth_at_scans, world_from_map);
   char text[1024];
   std::snprintf(text, sizeof(text),
                 "free_iou: %.4f\ntrue_free_cells: %lld\nmap_free_cells: %lld\nwalls_within_2_cells: %.4f\n"
                 "wall_distance_mean_cells: %.3f\nwall_distance_p95_cells: %.3f\ntrajectory_poses: %d\n"
-                "trajectory_rmse_m: %.4f\ntrajectory_max_m: %.4f\nyaw_rmse_rad: %.4f\n",
+                "trajectory_rmse_m: %.4f\ntrajectory_max_m: %.4f\nyaw_rmse_rad: %.4f\nrelations: %d\n"
+                "relative_translation_mean_m: %.4f\nrelative_rotation_mean_rad: %.4f\n"
+                "relative_translation_per_metre: %.4f\n",
                 quality.free_iou, quality.true_free_cells, quality.map_free_cells, quality.walls_within_2_cells,
                 quality.wall_distance_mean, quality.wall_distance_p95, trajectory.poses, trajectory.position_rmse,
-                trajectory.position_max, trajectory.yaw_rmse);
+                trajectory.position_max, trajectory.yaw_rmse, trajectory.relations,
+                trajectory.relative_translation_mean, trajectory.relative_rotation_mean,
+                trajectory.relative_translation_per_metre);
   std::printf("%s", text);
   if (!metrics_path.empty()) {
     std::ostringstream out;

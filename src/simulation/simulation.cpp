@@ -369,6 +369,13 @@ Simulation::Simulation(const SimulationWorld& world, const SimulationOptions& op
 
   if (options_.start_pose) {
     start_pose_ = *options_.start_pose;
+    const common::OccupancyGrid& free_space = world_.free_space;
+    int col = 0, row = 0;
+    if (!free_space.empty() && !(free_space.cellOf(common::Point2(start_pose_.x, start_pose_.y), &col, &row) &&
+                                 free_space.cells(row, col) == common::OccupancyGrid::kFree))
+      throw common::InputError("simulation options", "the start pose (" + common::formatNumber(start_pose_.x) +
+                                                         ", " + common::formatNumber(start_pose_.y) +
+                                                         ") is not in the world's free space");
   } else {
     // The free point farthest from anything else, in a corridor when the world has one.
     const common::OccupancyGrid& free_space = world_.free_space;

@@ -59,6 +59,11 @@ void validate(const RenderOptions& options, double wall_thickness) {
   if (!positive(options.resolution)) throw common::InputError("render options", "resolution must be positive");
   if (!positive(options.door_width)) throw common::InputError("render options", "door width must be positive");
   if (!positive(wall_thickness)) throw common::InputError("render options", "wall thickness must be positive");
+  if (wall_thickness > RenderOptions::kMaxWallThickness)
+    throw common::InputError("render options", "wall thickness " + common::formatNumber(wall_thickness) +
+                                                   " m is more than " +
+                                                   common::formatNumber(RenderOptions::kMaxWallThickness) +
+                                                   " m (a length in pixels? the thickness is in metres)");
   if (!std::isfinite(options.margin) || options.margin < 0.0)
     throw common::InputError("render options", "margin must be zero or positive");
 }

@@ -204,6 +204,20 @@ TEST_F(MapFromBag, BadInputGivesAClearErrorAndExitCode2) {
   EXPECT_EQ(result.exit_code, 2) << result.output;
   EXPECT_NE(result.output.find("no sensor_msgs/LaserScan"), std::string::npos) << result.output;
 
+  {  // an ICP method for points maps with the grid's proposal: MRPT asserts mid-run (before: exit 1, a stack trace)
+    std::string ini = testing::readFile(std::string(HIDDEN_ROOMS_SOURCE_DIR) + "/config/rbpf.ini");
+    const size_t at = ini.find("icpClassic");
+    ASSERT_NE(at, std::string::npos);
+    std::ofstream(dir_ + "/mismatched.ini") << ini.replace(at, 10, "icpLevenbergMarquardt");
+  }
+  result = testing::runCommand(tool + " " + dir_ + "/run.bag --quiet --config " + dir_ + "/mismatched.ini --out " +
+                               dir_ + "/x");
+  EXPECT_EQ(result.exit_code, 2) << result.output;
+  EXPECT_NE(result.output.find("mismatched.ini: MRPT rejects these options while mapping: Assert condition failed"),
+            std::string::npos)
+      << result.output;
+  EXPECT_EQ(std::count(result.output.begin(), result.output.end(), '\n'), 1) << result.output;
+
   std::ofstream(dir_ + "/bad.ini") << "[MappingApplication]\nPF_algorithm = 2\n";
   result = testing::runCommand(tool + " " + dir_ + "/run.bag --config " + dir_ + "/bad.ini --out " + dir_ + "/x");
   EXPECT_EQ(result.exit_code, 2) << result.output;

@@ -150,7 +150,7 @@ TEST_F(MapperTest, MapsTheWorldPublishesTfAndSavesTheMap) {
   EXPECT_GT(cv::countNonZero(saved.cells == 0), 1000);
   EXPECT_GT(cv::countNonZero(saved.cells == 100), 100);
 
-  save.request.prefix = "/nonexistent_folder/x";
+  save.request.prefix = prefix + ".yaml/x";  // a file where a folder must be
   ASSERT_TRUE(ros::service::call("save_map", save));
   EXPECT_FALSE(save.response.success);
   EXPECT_FALSE(save.response.message.empty());

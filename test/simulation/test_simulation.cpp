@@ -214,6 +214,10 @@ TEST(Simulation, BadInputGivesClearErrors) {
   bad.laser.range_noise = std::numeric_limits<double>::quiet_NaN();
   EXPECT_THROW(Simulation(world, bad), common::InputError);
   EXPECT_THROW(Simulation(world, quietOptions({4.0, 4.0, 0.0})), common::InputError);  // start pose on a wall
+  for (const common::Pose2 outside : {common::Pose2{500.0, 5.0, 0.0}, common::Pose2{-3.0, -3.0, 0.0}})
+    EXPECT_NE(testing::inputErrorMessage([&] { Simulation(world, quietOptions(outside)); })
+                  .find("is not in the world's free space"),
+              std::string::npos);
   EXPECT_THROW(laserCasterFromString("bresenham"), common::InputError);
   EXPECT_THROW(worldFromEnvironment(corridorWorld(), {5}), common::InputError);
   EXPECT_THROW(world::loadEnvironment("/nonexistent/world.xml"), common::InputError);

@@ -113,6 +113,11 @@ TEST(Render, RejectsBadOptions) {
   options.door_width = 0.0;
   EXPECT_THROW(renderEnvironment(environment, {}, options), common::InputError);
   EXPECT_THROW(renderEnvironment(environment, {5}, RenderOptions()), common::InputError);
+  options = RenderOptions();
+  options.wall_thickness = 1000.0;  // before: accepted, and the map was all wall
+  EXPECT_NE(testing::inputErrorMessage([&] { renderEnvironment(environment, {}, options); })
+                .find("wall thickness 1000 m is more than 1 m"),
+            std::string::npos);
 }
 
 // Free area = the spaces' area less the half wall each space loses along its outline, plus the door gaps.

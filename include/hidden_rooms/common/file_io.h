@@ -11,6 +11,11 @@
 
 namespace hidden_rooms::common {
 
+// Whether `path` is a regular file / a folder; false also when the path cannot be examined (a name too long, a
+// component that is a file, no permission), where std::filesystem's one-argument forms throw.
+bool isFile(const std::string& path);
+bool isFolder(const std::string& path);
+
 std::string readTextFile(const std::string& path, const std::string& what);
 YAML::Node loadYamlFile(const std::string& path, const std::string& what);
 

@@ -42,13 +42,17 @@ cv::Mat3b drawMapComparison(const common::OccupancyGrid& map, const common::Pose
 
 struct TrajectoryError {
   int poses = 0;
-  double position_rmse = 0.0;  // metres
+  double position_rmse = 0.0;  // metres, absolute (after world_from_map)
   double yaw_rmse = 0.0;       // radians
   double position_max = 0.0;   // metres
+  int relations = 0;                            // consecutive pose pairs
+  double relative_translation_mean = 0.0;       // metres per relation: |estimated motion - true motion|
+  double relative_rotation_mean = 0.0;          // radians per relation
+  double relative_translation_per_metre = 0.0;  // summed translation errors / distance travelled
 };
 
-// Error of `estimate` (map frame) against `truth` (world frame, same length and times) after placing the
-// estimate with `world_from_map`.
+// Error of `estimate` (map frame) against `truth` (world frame, same length and times): absolute after placing the
+// estimate with `world_from_map`, and relative between consecutive poses (independent of world_from_map).
 TrajectoryError trajectoryError(const std::vector<common::Pose2>& estimate, const std::vector<common::Pose2>& truth,
                                 const common::Pose2& world_from_map);
 

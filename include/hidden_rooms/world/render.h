@@ -21,6 +21,7 @@ struct RenderOptions {
   double door_width = 0.9;   // width of the gap cut at every open door, metres
   double margin = 1.0;       // unknown border around the environment, metres
   static constexpr double kDefaultWallThickness = 0.15;
+  static constexpr double kMaxWallThickness = 1.0;  // metres: the thickest walls of real buildings, and more
 };
 
 // resolution, door_width and margin with the ranges renderEnvironment accepts; the optional wall_thickness is
