@@ -68,7 +68,7 @@ std::string defaultConfig() {
 int run(int argc, char** argv) {
   std::string bag_path, prefix, config, scan_topic, odom_frame, base_frame, environment_path, reference_path, closed,
       metrics_path,
-      truth_topic, comparison_path, odom_topic;
+      truth_topic, comparison_path, odom_topic, trajectory_path;
   int seed = 0;
   bool quiet = false;
   po::options_description options("Options");
@@ -92,6 +92,7 @@ int run(int argc, char** argv) {
       ("comparison", po::value(&comparison_path),
        "when scoring: PNG of the map on the truth (white: both free; orange / red / magenta: observed free the "
        "map has unknown / uncertain / occupied; blue: map free where the truth is not observed free)")
+      ("trajectory", po::value(&trajectory_path), "also write the SLAM pose at every scan as a pose log (map frame)")
       ("quiet", po::bool_switch(&quiet), "no progress line");
   po::positional_options_description positional;
   positional.add("bag", 1);
@@ -209,7 +210,7 @@ int run(int argc, char** argv) {
     }
     const bool inserted = mapper.addScan(odometry, observation);
     ++processed;
-    if (scoring) {
+    if (scoring || !trajectory_path.empty()) {
       scan_times.push_back(scan.header.stamp.toSec());
       estimate.push_back(mapper.pose());
       if (inserted) inserted_scans.emplace_back(scan.header.stamp.toSec(), hidden_rooms::fromRos(upright, mount.pose));
@@ -286,6 +287,11 @@ int run(int argc, char** argv) {
               "wall_seconds: %.2f\nspeed_factor: %.1f\n",
               bag_path.c_str(), yaml.c_str(), processed, mapper.scansInserted(), dropped, bag_seconds, wall_seconds,
               bag_seconds / std::max(wall_seconds, 1e-9));
+  if (!trajectory_path.empty()) {
+    std::string log = hidden_rooms::common::poseLogHeader("map", base_frame);
+    for (size_t k = 0; k < scan_times.size(); ++k) log += hidden_rooms::common::poseLogLine({scan_times[k], estimate[k]});
+    hidden_rooms::common::writeTextAtomically(trajectory_path, log, "trajectory");
+  }
   if (!scoring) return hidden_rooms::common::kExitOk;
 
   if (true_poses.empty()) throw InputError(bag_path, "no nav_msgs/Odometry on " + truth_topic + " to score against");

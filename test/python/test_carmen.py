@@ -126,13 +126,18 @@ class RealLogsTest(unittest.TestCase):
             bag, reference = os.path.join(folder, name + ".bag"), os.path.join(folder, name + "_reference")
             subprocess.run([sys.executable, SCRIPT, log, "--out", bag, "--reference-map", reference,
                             "--odometry-noise", "0.05,2,0.01,0.5"], check=True, capture_output=True)
+            trajectory = os.path.join(folder, name + "_trajectory.log")
             result = subprocess.run([map_from_bag, bag, "--out", os.path.join(folder, name), "--quiet",
-                                     "--reference-map", reference + ".yaml"], capture_output=True, text=True)
+                                     "--reference-map", reference + ".yaml", "--trajectory", trajectory],
+                                    capture_output=True, text=True)
             self.assertEqual(result.returncode, 0, result.stderr)
             figures = dict(line.split(": ", 1) for line in result.stdout.splitlines() if ": " in line)
             print("%s, drifted odometry: %s" % (name, ", ".join("%s %s" % (key, figures[key]) for key in (
                 "free_iou", "walls_within_2_cells", "trajectory_rmse_m", "relative_translation_per_metre"))))
             self.assertEqual(int(figures["scans"]), {"intel": 910, "aces": 440}[name])
+            with open(trajectory) as stream:
+                poses = [line for line in stream if not line.startswith("#")]
+            self.assertEqual(len(poses), int(figures["scans"]), "one SLAM pose per scan")
             for key in ("free_iou", "walls_within_2_cells"):
                 self.assertTrue(0.0 < float(figures[key]) <= 1.0, key)
 
