@@ -3,7 +3,7 @@
 
 Usage: benchmark_closed_doors.py BENCH_DIR --method NAME [--methods A,B,...] [--part P] [--jobs N]
                                  [--binary PATH] [--keep DIR] [--params FILE.yaml] [--csv FILE] [--plot FILE.png]
-                                 [--agreement]
+                                 [--agreement] [--turn DEGREES]
 
 For every valid case of BENCH_DIR/cases.csv it runs `predict_rooms_offline` once per method (in parallel),
 times the whole command, reads the per-door IoU from the command's metrics.yaml and computes the thesis
@@ -12,7 +12,8 @@ of closed doors, one per environment, the overall mean IoU per method and of the
 peak memory per method. With --agreement it also compares each method's rooms with the thesis implementation's,
 room by room (the IoU of the method's room k with reference_rooms.png's room k; 1 when both are empty), per case
 and by number of closed doors, next to the IoU against the truth. Any folder in the benchmark's layout works,
-e.g. the cases of make_closed_door_corpus (whose cases.csv has a `part` column: --part validation).
+e.g. the cases of make_closed_door_corpus (whose cases.csv has a `part` column: --part validation). With --turn
+every case is first turned by that many degrees (map, true rooms and doors), as real SLAM maps are.
 
 Peak memory is the maximum resident set size of each command as measured by `/usr/bin/time -f %M` (GNU time),
 which wraps every run. resource.getrusage(RUSAGE_CHILDREN) is not used: on Linux a child started by this
@@ -125,6 +126,52 @@ def load_cases(bench_dir, part=None):
     if not cases:
         raise BenchmarkError("%s lists no valid case" % csv_path)
     return cases
+
+
+def turned_case(case, degrees, root):
+    """The case turned counter-clockwise by `degrees` about its map's centre, written under ROOT/ENV/CASE: as a SLAM
+    map whose frame starts off the building's axes. The map and the true rooms are resampled (nearest cell) onto a
+    grid that holds the whole turned map, unknown outside; the doors move with them (their orientation swaps at odd
+    quarter turns); the reference rooms are left out. Returns the turned Case."""
+    folder = os.path.join(root, case.env, case.name)
+    os.makedirs(folder, exist_ok=True)
+    with open(case.path("map.yaml")) as stream:
+        meta = yaml.safe_load(stream)
+    image = cv2.imread(os.path.join(case.folder, meta["image"]), cv2.IMREAD_UNCHANGED)
+    truth = read_label_image(case.path("gt_rooms.png"))
+    height, width = image.shape[:2]
+    turn = cv2.getRotationMatrix2D(((width - 1) / 2.0, (height - 1) / 2.0), degrees, 1.0)
+    cos, sin = abs(turn[0, 0]), abs(turn[0, 1])
+    new_width = int(np.ceil(width * cos + height * sin - 1e-6))
+    new_height = int(np.ceil(width * sin + height * cos - 1e-6))
+    turn[0, 2] += (new_width - width) / 2.0
+    turn[1, 2] += (new_height - height) / 2.0
+    unknown = 205 if image.dtype == np.uint8 else int(205 / 255 * np.iinfo(image.dtype).max)
+    cv2.imwrite(os.path.join(folder, "map.png"), cv2.warpAffine(
+        image, turn, (new_width, new_height), flags=cv2.INTER_NEAREST, borderValue=unknown))
+    cv2.imwrite(os.path.join(folder, "gt_rooms.png"), cv2.warpAffine(
+        truth, turn, (new_width, new_height), flags=cv2.INTER_NEAREST, borderValue=0))
+    resolution = float(meta["resolution"])
+    origin_x, origin_y = float(meta["origin"][0]), float(meta["origin"][1])
+    with open(case.path("doors.yaml")) as stream:
+        doors = yaml.safe_load(stream)
+    quarter_turns = int(round(degrees / 90.0))
+    for door in doors["doors"]:
+        x, y = door["position"]
+        # Pixel centres sit at whole coordinates for OpenCV; rows count down from the map's top.
+        column, row = (x - origin_x) / resolution - 0.5, height - (y - origin_y) / resolution - 0.5
+        new_column, new_row = turn @ np.array([column, row, 1.0])
+        door["position"] = [float(origin_x + (new_column + 0.5) * resolution),
+                            float(origin_y + (new_height - new_row - 0.5) * resolution)]
+        if quarter_turns % 2 and door.get("orientation") in ("O", "V"):
+            door["orientation"] = "V" if door["orientation"] == "O" else "O"
+    with open(os.path.join(folder, "doors.yaml"), "w") as stream:
+        yaml.safe_dump(doors, stream)
+    meta["image"] = "map.png"
+    with open(os.path.join(folder, "map.yaml"), "w") as stream:
+        yaml.safe_dump(meta, stream)
+    turned = Case({"env": case.env, "case": case.name, "part": case.part, "valid": "1"}, root)
+    return turned
 
 
 # --------------------------------------------------------------------------------------------------------
@@ -387,13 +434,15 @@ def print_overall(cases, methods, runs):
     name_width = max(len("reference"), *(len(method) for method in methods))
     for method in methods:
         method_runs = runs[method]
-        print("  %s  mean IoU %.4f over %d cases (%.4f over the %d with a reference), mean IoU_tot %.4f" % (
-            method.ljust(name_width), np.mean([run.mean_iou for run in method_runs]), len(method_runs),
-            np.mean([method_runs[i].mean_iou for i in with_reference]) if with_reference else float("nan"),
-            len(with_reference), np.mean([run.iou_total for run in method_runs])))
-    reference = mean_or_none(cases[i].reference_iou for i in with_reference)
-    print("  %s  mean IoU %s over %d cases" % ("reference".ljust(name_width), format_score(reference, 0),
-                                              len(with_reference)))
+        on_reference = " (%.4f over the %d with a reference)" % (
+            np.mean([method_runs[i].mean_iou for i in with_reference]), len(with_reference)) if with_reference else ""
+        print("  %s  mean IoU %.4f over %d cases%s, mean IoU_tot %.4f" % (
+            method.ljust(name_width), np.mean([run.mean_iou for run in method_runs]), len(method_runs), on_reference,
+            np.mean([run.iou_total for run in method_runs])))
+    if with_reference:
+        reference = mean_or_none(cases[i].reference_iou for i in with_reference)
+        print("  %s  mean IoU %s over %d cases" % ("reference".ljust(name_width), format_score(reference, 0),
+                                                  len(with_reference)))
     differences = [abs(case.reference_iou - case.csv_reference_iou) for case in cases
                    if case.reference_iou is not None and case.csv_reference_iou is not None]
     if differences:
@@ -543,6 +592,9 @@ def parse_arguments(argv):
     parser.add_argument("--plot", metavar="FILE.png", help="plot mean IoU vs closed doors to FILE.png")
     parser.add_argument("--agreement", action="store_true",
                         help="compare each method's rooms with reference_rooms.png, room by room")
+    parser.add_argument("--turn", type=float, default=0.0, metavar="DEGREES",
+                        help="turn every case's map, true rooms and doors by this many degrees counter-clockwise "
+                             "first (as a SLAM map off the building's axes); no reference scores then")
     parser.add_argument("--timeout", type=float, default=600.0,
                         help="seconds before a run is killed and counted as failed (default 600, 0 = none)")
     args = parser.parse_args(argv)
@@ -557,6 +609,10 @@ def parse_arguments(argv):
         parser.error("--jobs must be at least 1")
     if args.params and not os.path.isfile(args.params):
         parser.error("--params %s does not exist" % args.params)
+    if not np.isfinite(args.turn):
+        parser.error("--turn must be a finite number of degrees")
+    if args.turn and args.agreement:
+        parser.error("--agreement compares with the reference rooms of the straight maps: not with --turn")
     args.method_list = methods
     return args
 
@@ -575,17 +631,20 @@ def main(argv=None):
         print("benchmark_closed_doors.py: error: %s" % error, file=sys.stderr)
         return 2
 
-    for case in cases:
-        score_reference(case)
-    print("%s: %d valid cases, methods %s, %d jobs, binary %s" % (
-        args.bench_dir, len(cases), ", ".join(args.method_list), args.jobs, binary))
-    sys.stdout.flush()
-
     if args.keep:
         os.makedirs(args.keep, exist_ok=True)
         out_root = args.keep
     else:
         out_root = tempfile.mkdtemp(prefix="benchmark_closed_doors_")
+    if args.turn:
+        cases = [turned_case(case, args.turn, os.path.join(out_root, "turned")) for case in cases]
+    else:
+        for case in cases:
+            score_reference(case)
+    print("%s: %d valid cases%s, methods %s, %d jobs, binary %s" % (
+        args.bench_dir, len(cases), ", turned by %g degrees" % args.turn if args.turn else "",
+        ", ".join(args.method_list), args.jobs, binary))
+    sys.stdout.flush()
     params = os.path.abspath(args.params) if args.params else None
     try:
         runs = run_all(binary, cases, args.method_list, out_root, params, args.jobs, args.timeout, args.agreement)

@@ -163,6 +163,29 @@ class SmallBenchmark(unittest.TestCase):
         self.assertEqual(int(overall.group(2)), len(SELECTED_CASES))
         self.assertAlmostEqual(float(overall.group(1)), np.mean(list(expected.values())), delta=0.01)
 
+    def test_turned_cases_are_the_cases_turned(self):
+        """--turn: a quarter turn moves every cell exactly and swaps the doors' orientations; a run with a small turn
+        reports its turn and no reference scores."""
+        module = load_script_module()
+        case = module.load_cases(self.folder)[0]
+        root = tempfile.mkdtemp(prefix="bench_turned_")
+        quarter = module.turned_case(case, 90.0, root)
+        truth = module.read_label_image(case.path("gt_rooms.png"))
+        turned_truth = module.read_label_image(quarter.path("gt_rooms.png"))
+        np.testing.assert_array_equal(turned_truth, np.rot90(truth))
+        import yaml
+        with open(case.path("doors.yaml")) as a, open(quarter.path("doors.yaml")) as b:
+            straight_doors, turned_doors = yaml.safe_load(a)["doors"], yaml.safe_load(b)["doors"]
+        for straight, turned in zip(straight_doors, turned_doors):
+            self.assertNotEqual(straight["orientation"], turned["orientation"])
+        result = run_script(self.folder, "--method", self.method, "--jobs", "2", "--binary", self.binary,
+                            "--turn", "3")
+        self.assertEqual(result.returncode, 0, result.stdout + result.stderr)
+        self.assertIn("turned by 3 degrees", result.stdout)
+        self.assertNotIn("nan", result.stdout)
+        self.assertEqual(run_script(self.folder, "--method", self.method, "--turn", "3", "--agreement").returncode, 2)
+        shutil.rmtree(root, ignore_errors=True)
+
     def test_agreement_with_the_truth_as_reference(self):
         """With reference_rooms.png replaced by gt_rooms.png, a method's room-by-room agreement with the reference
         is its IoU against the truth, case by case."""
