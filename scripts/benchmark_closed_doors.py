@@ -170,8 +170,7 @@ def turned_case(case, degrees, root):
     meta["image"] = "map.png"
     with open(os.path.join(folder, "map.yaml"), "w") as stream:
         yaml.safe_dump(meta, stream)
-    turned = Case({"env": case.env, "case": case.name, "part": case.part, "valid": "1"}, root)
-    return turned
+    return Case({"env": case.env, "case": case.name, "part": case.part, "valid": "1"}, root)
 
 
 # --------------------------------------------------------------------------------------------------------

@@ -69,9 +69,9 @@ void removeStaleTemporaries(const std::filesystem::path& folder, const std::stri
 
 void writeAtomically(const std::string& path, const std::function<void(const std::string& temporary_path)>& write) {
   const std::filesystem::path target(path);
-  if (target.has_parent_path()) createOutputDirectory(target.parent_path().string());
-  removeStaleTemporaries(target.has_parent_path() ? target.parent_path() : std::filesystem::path("."),
-                         target.filename().string() + kTemporarySuffix);
+  const std::filesystem::path folder = target.has_parent_path() ? target.parent_path() : ".";
+  createOutputDirectory(folder.string());
+  removeStaleTemporaries(folder, target.filename().string() + kTemporarySuffix);
   // Unique per process, in the target's folder (a rename within one file system is atomic).
   const std::string temporary = path + kTemporarySuffix + std::to_string(getpid());
   std::error_code ignored;
@@ -105,12 +105,6 @@ void createOutputDirectory(const std::string& path) {
     throw InputError(path, "cannot create output folder" + (error ? ": " + error.message() : std::string()));
 }
 
-namespace {
-
-constexpr const char* kStagingPrefix = ".partial";
-
-}  // namespace
-
 OutputFolder::OutputFolder(const std::string& out, const std::vector<std::string>& inputs) : out_(out) {
   namespace fs = std::filesystem;
   std::error_code missing;
@@ -123,8 +117,9 @@ OutputFolder::OutputFolder(const std::string& out, const std::vector<std::string
     close(lock_fd_);
     throw InputError(out, "another run is writing into this output folder (it holds the folder's lock)");
   }
-  removeStaleTemporaries(folder, kStagingPrefix);
-  staging_ = (folder / (kStagingPrefix + std::to_string(getpid()))).string();
+  // The staging folder is the temporary of a nameless file: OUT/.partialPID.
+  removeStaleTemporaries(folder, kTemporarySuffix);
+  staging_ = (folder / (kTemporarySuffix + std::to_string(getpid()))).string();
   std::error_code ignored;
   fs::remove_all(staging_, ignored);
   createOutputDirectory(staging_);

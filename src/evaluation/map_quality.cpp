@@ -5,6 +5,8 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "hidden_rooms/common/geometry.h"
+
 namespace hidden_rooms::evaluation {
 
 namespace {
@@ -148,7 +150,7 @@ TrajectoryError trajectoryError(const std::vector<common::Pose2>& estimate, cons
     const common::Pose2 moved = common::composePoses(common::invertPose(estimate[i - 1]), estimate[i]);
     const common::Pose2 truly = common::composePoses(common::invertPose(truth[i - 1]), truth[i]);
     translation_sum += std::hypot(moved.x - truly.x, moved.y - truly.y);
-    rotation_sum += std::abs(std::atan2(std::sin(moved.yaw - truly.yaw), std::cos(moved.yaw - truly.yaw)));
+    rotation_sum += std::abs(common::wrapAngle(moved.yaw - truly.yaw));
     distance += std::hypot(truly.x, truly.y);
   }
   if (n > 1) {

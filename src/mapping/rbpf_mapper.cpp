@@ -40,7 +40,6 @@ bool finite(const common::Pose2& pose) {
   return std::isfinite(pose.x) && std::isfinite(pose.y) && std::isfinite(pose.yaw);
 }
 
-// The odometry motion model from the ini's [MotionModel] section (MRPT has no loader for it).
 // The line of an MRPT exception that says what went wrong (its text carries a banner and a stack trace).
 std::string mrptMessage(const std::exception& error) {
   std::istringstream text(error.what());
@@ -52,6 +51,7 @@ std::string mrptMessage(const std::exception& error) {
   return first;
 }
 
+// The odometry motion model from the ini's [MotionModel] section (MRPT has no loader for it).
 mrpt::obs::CActionRobotMovement2D::TMotionModelOptions readMotionModel(const mrpt::config::CConfigFileBase& ini,
                                                                        const std::string& file) {
   mrpt::obs::CActionRobotMovement2D::TMotionModelOptions model;

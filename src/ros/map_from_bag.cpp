@@ -67,8 +67,7 @@ std::string defaultConfig() {
 
 int run(int argc, char** argv) {
   std::string bag_path, prefix, config, scan_topic, odom_frame, base_frame, environment_path, reference_path, closed,
-      metrics_path,
-      truth_topic, comparison_path, odom_topic, trajectory_path;
+      metrics_path, truth_topic, comparison_path, odom_topic, trajectory_path;
   int seed = 0;
   bool quiet = false;
   po::options_description options("Options");
@@ -87,7 +86,7 @@ int run(int argc, char** argv) {
        "score the map against this map, in the frame of the true poses (carmen_to_bag --reference-map)")
       ("closed-doors", po::value(&closed)->default_value(""), "with --environment: doors closed in the run")
       ("truth-topic", po::value(&truth_topic)->default_value("base_pose_ground_truth"),
-       "with --environment: nav_msgs/Odometry of the true pose in the world frame")
+       "when scoring: nav_msgs/Odometry of the true pose in the world frame")
       ("metrics", po::value(&metrics_path), "when scoring: also write the figures to this YAML file")
       ("comparison", po::value(&comparison_path),
        "when scoring: PNG of the map on the truth (white: both free; orange / red / magenta: observed free the "
@@ -168,8 +167,7 @@ int run(int argc, char** argv) {
   tf2::BufferCore tf_buffer(ros::Duration(std::max(60.0, bag_seconds + 10.0)));
   std::deque<sensor_msgs::LaserScan::ConstPtr> pending;
   std::vector<TimedPose> true_poses;
-  std::vector<double> scan_times;
-  std::vector<Pose2> estimate;
+  std::vector<TimedPose> estimated;  // the SLAM pose at every scan's stamp
   std::vector<std::pair<double, hidden_rooms::common::RangeScan>> inserted_scans;  // for the observed cells
   int processed = 0, dropped = 0, received = 0, without_returns = 0, without_mount = 0;
   std::string last_tf_error, last_mount_error;
@@ -211,8 +209,7 @@ int run(int argc, char** argv) {
     const bool inserted = mapper.addScan(odometry, observation);
     ++processed;
     if (scoring || !trajectory_path.empty()) {
-      scan_times.push_back(scan.header.stamp.toSec());
-      estimate.push_back(mapper.pose());
+      estimated.push_back({scan.header.stamp.toSec(), mapper.pose()});
       if (inserted) inserted_scans.emplace_back(scan.header.stamp.toSec(), hidden_rooms::fromRos(upright, mount.pose));
     }
   };
@@ -289,7 +286,7 @@ int run(int argc, char** argv) {
               bag_seconds / std::max(wall_seconds, 1e-9));
   if (!trajectory_path.empty()) {
     std::string log = hidden_rooms::common::poseLogHeader("map", base_frame);
-    for (size_t k = 0; k < scan_times.size(); ++k) log += hidden_rooms::common::poseLogLine({scan_times[k], estimate[k]});
+    for (const TimedPose& pose : estimated) log += hidden_rooms::common::poseLogLine(pose);
     hidden_rooms::common::writeTextAtomically(trajectory_path, log, "trajectory");
   }
   if (!scoring) return hidden_rooms::common::kExitOk;
@@ -297,11 +294,12 @@ int run(int argc, char** argv) {
   if (true_poses.empty()) throw InputError(bag_path, "no nav_msgs/Odometry on " + truth_topic + " to score against");
   std::sort(true_poses.begin(), true_poses.end(),
             [](const TimedPose& a, const TimedPose& b) { return a.time < b.time; });
-  std::vector<Pose2> truth_at_scans;
-  for (double t : scan_times) truth_at_scans.push_back(poseAt(true_poses, t));
+  std::vector<Pose2> estimate, truth_at_scans;
+  for (const TimedPose& pose : estimated) {
+    estimate.push_back(pose.pose);
+    truth_at_scans.push_back(poseAt(true_poses, pose.time));
+  }
   // The map placed in the truth's frame by the least-squares rigid fit of the whole trajectory.
-  std::vector<TimedPose> estimated;
-  for (size_t k = 0; k < scan_times.size(); ++k) estimated.push_back({scan_times[k], estimate[k]});
   const Pose2 world_from_map = hidden_rooms::evaluation::fitWorldFromMap(true_poses, estimated);
   cv::Mat1b observed;
   for (const auto& [time, scan] : inserted_scans)

@@ -367,9 +367,9 @@ Simulation::Simulation(const SimulationWorld& world, const SimulationOptions& op
     door_bodies_.push_back(body);
   }
 
+  const common::OccupancyGrid& free_space = world_.free_space;
   if (options_.start_pose) {
     start_pose_ = *options_.start_pose;
-    const common::OccupancyGrid& free_space = world_.free_space;
     int col = 0, row = 0;
     if (!free_space.empty() && !(free_space.cellOf(common::Point2(start_pose_.x, start_pose_.y), &col, &row) &&
                                  free_space.cells(row, col) == common::OccupancyGrid::kFree))
@@ -378,7 +378,6 @@ Simulation::Simulation(const SimulationWorld& world, const SimulationOptions& op
                                                          ") is not in the world's free space");
   } else {
     // The free point farthest from anything else, in a corridor when the world has one.
-    const common::OccupancyGrid& free_space = world_.free_space;
     if (free_space.empty()) throw common::InputError("simulation world", "no free space to start in: set a start pose");
     const cv::Mat1b free_cells = free_space.cells == common::OccupancyGrid::kFree;
     cv::Mat1b candidates = free_cells.clone();

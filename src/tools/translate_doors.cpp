@@ -95,10 +95,14 @@ int run(int argc, char** argv) {
   const common::OccupancyGrid map = map_path.empty() ? common::OccupancyGrid() : common::loadMap(map_path);
   common::OutputFolder out(out_dir, {environment_path, truth_path, estimate_path, map_path});
   common::saveDoors(doors, out.file("doors.yaml"));
-  if (map_path.empty()) {
+  // Every output in place at once, then reported.
+  const auto commit = [&] {
     out.commit();
-    std::cout << "translate_doors: " << doors.doors.size() << " closed doors -> " << (std::filesystem::path(out_dir) / "doors.yaml").string()
-              << std::endl;
+    std::cout << "translate_doors: " << doors.doors.size() << " closed doors -> "
+              << (std::filesystem::path(out_dir) / "doors.yaml").string() << std::endl;
+  };
+  if (map_path.empty()) {
+    commit();
     return common::kExitOk;
   }
 
@@ -152,9 +156,7 @@ int run(int argc, char** argv) {
            << "}\n";
   }
   common::writeTextAtomically(out.file("exploration.yaml"), report.str(), "exploration report");
-  out.commit();
-  std::cout << "translate_doors: " << doors.doors.size() << " closed doors -> " << (std::filesystem::path(out_dir) / "doors.yaml").string()
-            << std::endl;
+  commit();
   std::cout << "translate_doors: coverage " << std::fixed << std::setprecision(3)
             << coverage << " (all free cells " << coverageOf(all_free) << ")"
             << ", free IoU " << all_free.free_iou << ", worst door error " << worst_error << " m -> "

@@ -32,11 +32,10 @@ void createOutputDirectory(const std::string& path);
 
 // A tool's output folder, written all or nothing: the files of a run go to a staging folder inside it
 // (OUT/.partialPID) and commit() moves them into OUT, each replacing the previous run's file of that name; an
-// OutputFolder destroyed without commit() (an error) removes its staging folder, so OUT keeps what it held (an OUT it
-// created is removed). The
-// constructor creates OUT and locks it (flock on the folder itself, held until destruction); staging folders
-// of runs that no longer run are removed. Throws InputError naming OUT when it cannot be created, when another run
-// holds its lock, and (file()) when an output would replace one of `inputs`.
+// OutputFolder destroyed without commit() (an error) removes its staging folder, so OUT keeps what it held (an OUT
+// it created is removed). The constructor creates OUT and locks it (flock on the folder itself, held until
+// destruction); staging folders of runs that no longer run are removed. Throws InputError naming OUT when it cannot
+// be created, when another run holds its lock, and (file()) when an output would replace one of `inputs`.
 class OutputFolder {
  public:
   OutputFolder(const std::string& out, const std::vector<std::string>& inputs);
@@ -51,7 +50,6 @@ class OutputFolder {
   // Moves every staged file into OUT. Checks first that each can replace what OUT holds under its name (not a
   // folder), so that a blocked name leaves OUT as it was.
   void commit();
-  const std::string& path() const { return out_; }
 
  private:
   std::string out_;
