@@ -87,15 +87,46 @@ int headerNumber(const std::string& data, size_t* pos, const std::string& path, 
   return value;
 }
 
-cv::Mat readNetpbm(const std::string& path, const std::string& data) {
+constexpr size_t kNetpbmHeaderBytes = 65536;      // a longer header (comments) is refused
+constexpr size_t kMaxAsciiBytesPerSample = 16;    // digits and white space of one plain-PGM/PPM sample
+
+struct NetpbmHeader {
+  int width, height, max_value, channels;
+  bool ascii;
+  size_t pixels_start;  // offset of the first pixel byte (binary) or token (plain)
+};
+
+NetpbmHeader readNetpbmHeader(const std::string& path, const std::string& data) {
+  NetpbmHeader header;
   const char kind = data[1];
-  const bool ascii = kind == '2' || kind == '3';
-  const int channels = (kind == '3' || kind == '6') ? 3 : 1;
+  header.ascii = kind == '2' || kind == '3';
+  header.channels = (kind == '3' || kind == '6') ? 3 : 1;
   size_t pos = 2;
-  const int width = headerNumber(data, &pos, path, "width", 1 << 16);
-  const int height = headerNumber(data, &pos, path, "height", 1 << 16);
-  const int max_value = headerNumber(data, &pos, path, "maxval", 65535);
-  checkImageSize(path, width, height);
+  header.width = headerNumber(data, &pos, path, "width", 1 << 16);
+  header.height = headerNumber(data, &pos, path, "height", 1 << 16);
+  header.max_value = headerNumber(data, &pos, path, "maxval", 65535);
+  checkImageSize(path, header.width, header.height);
+  header.pixels_start = pos;
+  return header;
+}
+
+// Refuses a file longer than its header's pixels can fill (a plain file padded with gigabytes of white space).
+void checkNetpbmFileSize(const std::string& path, const std::string& head_bytes, size_t file_bytes) {
+  const NetpbmHeader header = readNetpbmHeader(path, head_bytes);
+  if (head_bytes.size() == kNetpbmHeaderBytes && header.pixels_start >= kNetpbmHeaderBytes)
+    throw InputError(path, "Netpbm header is longer than " + std::to_string(kNetpbmHeaderBytes) + " bytes");
+  const double samples = static_cast<double>(header.width) * header.height * header.channels;
+  const double bytes_per_sample = header.ascii ? kMaxAsciiBytesPerSample : (header.max_value > 255 ? 2 : 1);
+  checkLimit(path, "the file's size in bytes", static_cast<double>(file_bytes),
+             static_cast<double>(header.pixels_start + kNetpbmHeaderBytes) + samples * bytes_per_sample,
+             " (what the pixels its header declares can fill)");
+}
+
+cv::Mat readNetpbm(const std::string& path, const std::string& data) {
+  const NetpbmHeader header = readNetpbmHeader(path, data);
+  const int width = header.width, height = header.height, max_value = header.max_value, channels = header.channels;
+  const bool ascii = header.ascii;
+  size_t pos = header.pixels_start;
   const bool sixteen = max_value > 255;
   const size_t samples = static_cast<size_t>(width) * height * channels;
   if (samples > data.size() - pos) throw InputError(path, "Netpbm pixel data is truncated");
@@ -180,6 +211,14 @@ cv::Mat readImage(const std::string& path) {
   file.read(reinterpret_cast<char*>(head), sizeof(head));
   if (file.gcount() == sizeof(head) && std::memcmp(head, kPngSignature, sizeof(head)) == 0) return readPng(path);
   if (file.gcount() >= 2 && head[0] == 'P' && std::strchr("2356", head[1]) != nullptr) {
+    // The header's size is checked on the file's first bytes, before a file of any length is read whole.
+    file.clear();
+    file.seekg(0);
+    std::string head_bytes(kNetpbmHeaderBytes, '\0');
+    file.read(head_bytes.data(), static_cast<std::streamsize>(head_bytes.size()));
+    head_bytes.resize(static_cast<size_t>(file.gcount()));
+    const size_t file_bytes = static_cast<size_t>(std::filesystem::file_size(path));
+    checkNetpbmFileSize(path, head_bytes, file_bytes);
     file.clear();
     file.seekg(0);
     const std::string data((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());

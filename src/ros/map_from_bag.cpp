@@ -119,6 +119,7 @@ int run(int argc, char** argv) {
   hidden_rooms::common::OccupancyGrid truth_map;  // in the frame of the true poses
   if (!environment_path.empty()) {
     const hidden_rooms::world::Environment environment = hidden_rooms::world::loadEnvironment(environment_path);
+    hidden_rooms::world::printRepairs(environment, environment_path, std::cerr);
     truth_map = hidden_rooms::world::renderEnvironment(
                     environment, hidden_rooms::world::parseDoorSelection(environment, closed, "--closed-doors"))
                     .map;

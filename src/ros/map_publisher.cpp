@@ -46,6 +46,8 @@ MapPublisher::MapPublisher(ros::NodeHandle nh, const MapPublisherOptions& option
     grid = common::loadMap(options.map_file);
   } else {
     const world::Environment environment = world::loadEnvironment(options.environment);
+    for (const std::string& repair : environment.repairs)
+      ROS_WARN("%s: %s", options.environment.c_str(), repair.c_str());
     grid =
         world::renderEnvironment(
             environment, world::parseDoorSelection(environment, options.closed_doors, "~closed_doors"), options.render)

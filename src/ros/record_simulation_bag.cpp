@@ -48,6 +48,7 @@ int run(int argc, char** argv) {
   if (seed < 0) throw InputError("--seed", "must be zero or positive");
 
   const hidden_rooms::world::Environment environment = hidden_rooms::world::loadEnvironment(world_path);
+  hidden_rooms::world::printRepairs(environment, world_path, std::cerr);
   hidden_rooms::simulation::SimulationOptions simulation_options;
   simulation_options.seed = static_cast<uint64_t>(seed);
   hidden_rooms::simulation::Simulation simulation(

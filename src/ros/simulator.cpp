@@ -167,6 +167,8 @@ Simulator::Simulator(ros::NodeHandle nh, const SimulatorOptions& options) : opti
   simulation::SimulationWorld world;
   if (!options.environment.empty()) {
     const world::Environment environment = world::loadEnvironment(options.environment);
+    for (const std::string& repair : environment.repairs)
+      ROS_WARN("%s: %s", options.environment.c_str(), repair.c_str());
     world = simulation::worldFromEnvironment(
         environment, world::parseDoorSelection(environment, options.closed_doors, "~closed_doors"), options.render);
   } else if (!options.map_file.empty()) {

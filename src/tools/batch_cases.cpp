@@ -127,6 +127,7 @@ int run(int argc, char** argv) {
     return common::kExitOk;
 
   const world::Environment environment = world::loadEnvironment(environment_path);
+  world::printRepairs(environment, environment_path, std::cerr);
   std::vector<std::unique_ptr<prediction::RoomPredictor>> methods;
   for (const std::string& name : splitList(methods_text)) methods.push_back(prediction::makeRoomPredictor(name));
   std::map<std::string, double> parameters;

@@ -111,6 +111,7 @@ int run(int argc, char** argv) {
     world = simulation::worldFromGrid(common::loadMap(world_path));
   } else {
     const world::Environment environment = world::loadEnvironment(world_path);
+    world::printRepairs(environment, world_path, std::cerr);
     world =
         simulation::worldFromEnvironment(environment, world::parseDoorSelection(environment, closed_spec, "--closed"));
   }

@@ -78,6 +78,7 @@ int run(int argc, char** argv) {
   pipeline::validate(run_options);
 
   const world::Environment environment = world::loadEnvironment(environment_path);
+  world::printRepairs(environment, environment_path, std::cerr);
   const std::set<int> closed = world::parseDoorSelection(environment, closed_spec, "--closed");
   const simulation::SimulationWorld world = simulation::worldFromEnvironment(environment, closed);
   run_options.simulation.seed = static_cast<uint64_t>(seed);

@@ -51,6 +51,7 @@ int run(int argc, char** argv) {
   if (values.count("wall-thickness")) render_options.wall_thickness = wall_thickness;
 
   const world::Environment environment = world::loadEnvironment(environment_path);
+  world::printRepairs(environment, environment_path, std::cerr);
   const std::set<int> closed = world::parseDoorSelection(environment, closed_spec, "--closed");
   const world::RenderedEnvironment rendered = world::renderEnvironment(environment, closed, render_options);
 

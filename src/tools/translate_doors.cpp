@@ -75,6 +75,7 @@ int run(int argc, char** argv) {
   render_options.door_width = door_width;
 
   const world::Environment environment = world::loadEnvironment(environment_path);
+  world::printRepairs(environment, environment_path, std::cerr);
   const std::set<int> closed = world::parseDoorSelection(environment, closed_spec, "--closed");
   const world::RenderedEnvironment rendered = world::renderEnvironment(environment, closed, render_options);
   // The closed doors that hide a room (closable): a closed door of a room with another door hides nothing.

@@ -1,5 +1,6 @@
 #include "hidden_rooms/world/environment.h"
 
+#include <opencv2/imgproc.hpp>
 #include <tinyxml2.h>
 
 #include <algorithm>
@@ -26,6 +27,40 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr double kPortalOnWallTolerancePixels = 2.5;
 // Outlines may cross themselves this close (metres) to a corner: drawing slop in real floor plans.
 constexpr double kOutlineCornerTolerance = 0.25;
+// Copies of one PORTAL id closer than this (metres, a double door's width) are one door: real plans give a door's
+// two jambs as two copies about 0.9 m apart.
+constexpr double kSamePortalDistance = 2.0;
+// An outline that runs over itself (traced twice, looping around a part of itself) fills, drawn even-odd as the
+// renderer draws it, another area than the one its vertices enclose; raster error stays well under this fraction.
+constexpr double kFilledAreaTolerance = 0.1;
+constexpr double kAreaCheckPixels = 2.5e5;    // the outline's area in pixels of the raster measuring its fill
+constexpr double kAreaCheckMaxPixels = 1e6;   // pixels of that raster at most (a thin, long, slanted outline)
+
+// The area (m2) that an even-odd fill of `polygon` covers, measured on a raster fine enough for the polygon's area.
+double evenOddArea(const common::Polygon& polygon) {
+  const double enclosed = common::area(polygon);
+  if (enclosed <= 0.0) return 0.0;
+  common::Point2 low = polygon.front(), high = polygon.front();
+  for (const common::Point2& p : polygon) {
+    low = low.cwiseMin(p);
+    high = high.cwiseMax(p);
+  }
+  const common::Point2 size = high - low;
+  const double pixels_per_metre =
+      std::min(std::sqrt(kAreaCheckPixels / enclosed), std::sqrt(kAreaCheckMaxPixels / (size.x() * size.y())));
+  const cv::Size raster(static_cast<int>(std::ceil(size.x() * pixels_per_metre)) + 2,
+                        static_cast<int>(std::ceil(size.y() * pixels_per_metre)) + 2);
+  constexpr int kShift = 8;  // vertices with 1/256 pixel precision
+  std::vector<cv::Point> vertices;
+  for (const common::Point2& p : polygon) {
+    const common::Point2 pixel = (p - low) * pixels_per_metre + common::Point2(1.0, 1.0);
+    vertices.emplace_back(static_cast<int>(std::lround(pixel.x() * (1 << kShift))),
+                          static_cast<int>(std::lround(pixel.y() * (1 << kShift))));
+  }
+  cv::Mat1b fill = cv::Mat1b::zeros(raster);
+  cv::fillPoly(fill, std::vector<std::vector<cv::Point>>{vertices}, cv::Scalar(255), cv::LINE_8, kShift);
+  return cv::countNonZero(fill) / (pixels_per_metre * pixels_per_metre);
+}
 
 std::string lineOf(const XMLElement* element) { return "line " + std::to_string(element->GetLineNum()); }
 
@@ -233,7 +268,14 @@ void deriveDoors(Environment* environment, const std::string& source_name) {
     for (const LineSegment& segment : environment->spaces[s].segments) {
       if (segment.segment_class != SegmentClass::kPortal) continue;
       auto found = door_of_segment.find(segment.id);
-      if (found == door_of_segment.end()) {
+      if (found != door_of_segment.end()) {
+        Door& door = environment->doors[found->second];
+        const double apart = (0.5 * (segment.a + segment.b) - door.centre).norm();
+        if (apart > kSamePortalDistance)
+          environment->repairs.push_back("portal '" + segment.id + "' appears at two places " +
+                                         common::formatNumber(std::round(apart * 100.0) / 100.0) +
+                                         " m apart; the door is placed at its first appearance");
+      } else {
         Door door;
         door.id = segment.id;
         door.number = static_cast<int>(environment->doors.size()) + 1;
@@ -372,11 +414,22 @@ Environment parseEnvironment(const std::string& xml_text, const std::string& sou
       segment.b = toMetres(segment.b);
     }
     space.outline = common::withoutRepeatedVertices(space.outline);
-    if (space.outline.size() < 3) continue;  // degenerate (real files have a few): a space with no area
+    const std::string where = "space '" + space.id + "' (line " + std::to_string(space_line[space.id]) + ")";
+    if (space.outline.size() < 3) {  // real files have a few
+      environment.repairs.push_back("the outline of " + where +
+                                    " has fewer than 3 distinct vertices; the space has no floor");
+      continue;
+    }
     std::string problem;
     if (common::hasCrossing(space.outline, kOutlineCornerTolerance, &problem))
-      throw common::InputError(source, "outline of space '" + space.id + "' (line " +
-                                           std::to_string(space_line[space.id]) + ") crosses itself: " + problem);
+      throw common::InputError(source, "outline of " + where + " crosses itself: " + problem);
+    const double enclosed = common::area(space.outline);
+    const double filled = evenOddArea(space.outline);
+    if (std::abs(filled - enclosed) > kFilledAreaTolerance * enclosed)
+      throw common::InputError(source, "outline of " + where + " runs over itself: it encloses " +
+                                           common::formatNumber(std::round(enclosed * 10.0) / 10.0) +
+                                           " m2 but a drawing of it fills " +
+                                           common::formatNumber(std::round(filled * 10.0) / 10.0) + " m2");
   }
   deriveDoors(&environment, source);
   for (Door& door : environment.doors) {
@@ -384,6 +437,10 @@ Environment parseEnvironment(const std::string& xml_text, const std::string& sou
     if (status != portal_status.end()) door.status = status->second;
   }
   return environment;
+}
+
+void printRepairs(const Environment& environment, const std::string& source, std::ostream& out) {
+  for (const std::string& repair : environment.repairs) out << "warning: " << source << ": " << repair << "\n";
 }
 
 Environment loadEnvironment(const std::string& path) {

@@ -249,5 +249,21 @@ TEST(ImageIo, AnImageDeclaringTooManyPixelsIsRefusedBeforeItsPixelsAreAllocated)
             std::string::npos);
 }
 
+TEST(ImageIo, APlainPgmLongerThanItsPixelsCanFillIsRefusedBeforeItIsRead) {
+  const std::string dir = testing::makeTempDir("image_padding");
+  {
+    std::ofstream padded(dir + "/padded.pgm");
+    padded << "P2\n2 2\n255\n0 255 255 0";
+    padded << std::string(200000, ' ') << "\n";  // a 2 x 2 image of 200 kB (the issue's was gigabytes)
+    std::ofstream(dir + "/long_header.pgm") << "P2\n#" << std::string(70000, 'c') << "\n2 2\n255\n0 255 255 0\n";
+  }
+  const std::string padded = testing::inputErrorMessage([&] { readImage(dir + "/padded.pgm"); });
+  EXPECT_NE(padded.find("the file's size in bytes is 200"), std::string::npos) << padded;
+  EXPECT_NE(padded.find("what the pixels its header declares can fill"), std::string::npos) << padded;
+  EXPECT_FALSE(testing::inputErrorMessage([&] { readImage(dir + "/long_header.pgm"); }).empty());
+  std::ofstream(dir + "/fine.pgm") << "P2\n2 2\n255\n0 255 255 0\n\n";
+  EXPECT_EQ(readImage(dir + "/fine.pgm").total(), 4u);
+}
+
 }  // namespace
 }  // namespace hidden_rooms::common

@@ -328,6 +328,13 @@ TEST(RoomPredictor, BadRequestsFailWithAMessageAndTheNodeKeepsServing) {
         hidden_rooms::toRos(hidden_rooms::common::loadMap(caseDir() + "/map.yaml"), "map", ros::Time::now());
     expectFailure(&no_doors, {"no doors", "closed_doors_file"}, "/no_map/predict_rooms");
   }
+  {
+    SCOPED_TRACE("the doors file's frame is not the map's");
+    PredictRooms service;  // no doors: the node's ~closed_doors_file (frame map) for a map in frame odom
+    service.request.map =
+        hidden_rooms::toRos(hidden_rooms::common::loadMap(caseDir() + "/map.yaml"), "odom", ros::Time::now());
+    expectFailure(&service, {"~closed_doors_file", "its doors are in frame 'map', the map in 'odom'"});
+  }
   // Still serving, and a good request with its own map and a parameter override works.
   PredictRooms service;
   service.request.doors = hidden_rooms::toRos(doors);

@@ -1,4 +1,6 @@
 #include <gtest/gtest.h>
+
+#include <sstream>
 #include <tinyxml2.h>
 
 #include <cmath>
@@ -186,6 +188,41 @@ TEST(Environment, RejectsASelfIntersectingOutline) {
       "<point x=\"0\" y=\"40\"/><point x=\"80\" y=\"120\"/><point x=\"80\" y=\"40\"/><point x=\"0\" y=\"120\"/>");
   expectError(xml, "outline of space 'room_a'");
   expectError(xml, "crosses itself");
+}
+
+TEST(Environment, RejectsAnOutlineThatRunsOverItself) {
+  // The corridor's outline loops twice around its right half: no edge crosses another, but drawn even-odd that
+  // half is empty (the degenerate corridor lost 64 % of its free cells to this).
+  const std::string corridor_outline =
+      "<point x=\"0\" y=\"0\"/><point x=\"0\" y=\"40\"/><point x=\"200\" y=\"40\"/><point x=\"200\" y=\"0\"/>";
+  const std::string looped = replaced(
+      corridorWithTwoRoomsXml(), corridor_outline,
+      "<point x=\"0\" y=\"0\"/><point x=\"0\" y=\"40\"/><point x=\"200\" y=\"40\"/><point x=\"200\" y=\"0\"/>"
+      "<point x=\"100\" y=\"0\"/><point x=\"100\" y=\"40\"/><point x=\"200\" y=\"40\"/><point x=\"200\" y=\"0\"/>");
+  expectError(looped, "outline of space 'corridor' (line 1) runs over itself: it encloses 30 m2 but a drawing of it "
+                      "fills 10");
+  expectError(replaced(corridorWithTwoRoomsXml(), corridor_outline, corridor_outline + corridor_outline),
+              "encloses 40 m2 but a drawing of it fills 0.");  // traced twice: only the edges are drawn
+}
+
+TEST(Environment, RepairsAreWarnedNotSilent) {
+  // A copy of door_a's PORTAL on room_a's west wall, 2.8 m from the first; room_b's outline of two points.
+  const std::string xml = replaced(
+      corridorWithTwoRoomsXml("", "<linesegment id=\"door_a\"><point x=\"0\" y=\"80\"/><point x=\"0\" y=\"80\"/>"
+                                  "<class>PORTAL</class></linesegment>"),
+      "<point x=\"80\" y=\"40\"/><point x=\"200\" y=\"40\"/><point x=\"200\" y=\"120\"/><point x=\"80\" y=\"120\"/>",
+      "<point x=\"80\" y=\"40\"/><point x=\"200\" y=\"40\"/>");
+  const Environment environment = parseEnvironment(xml, "synthetic");
+  ASSERT_EQ(environment.repairs.size(), 2u);
+  EXPECT_EQ(environment.repairs[0], "the outline of space 'room_b' (line 1) has fewer than 3 distinct vertices; the "
+                                    "space has no floor");
+  EXPECT_EQ(environment.repairs[1], "portal 'door_a' appears at two places 2.83 m apart; the door is placed at its "
+                                    "first appearance");
+  EXPECT_LT((environment.doors[0].centre - common::Point2(2.0, 4.0)).norm(), 1e-9);  // the first copy
+  std::ostringstream printed;
+  printRepairs(environment, "plan.xml", printed);
+  EXPECT_EQ(printed.str().find("warning: plan.xml: the outline of space 'room_b'"), 0u);
+  EXPECT_TRUE(parseEnvironment(corridorWithTwoRoomsXml(), "synthetic").repairs.empty());
 }
 
 TEST(Environment, RejectsADoorOnNoWall) {

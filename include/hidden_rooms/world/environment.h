@@ -1,6 +1,7 @@
 #pragma once
 
 #include <optional>
+#include <ostream>
 #include <set>
 #include <string>
 #include <vector>
@@ -73,6 +74,9 @@ struct Environment {
   std::optional<double> wall_thickness;
   std::vector<Space> spaces;
   std::vector<Door> doors;
+  // What the reader repaired rather than refused (docs/file_formats.md), one sentence each; tools print them as
+  // warnings (printRepairs).
+  std::vector<std::string> repairs;
 
   // All WALL segments of all spaces (walls shared by two spaces appear twice).
   std::vector<LineSegment> walls() const;
@@ -92,6 +96,9 @@ Environment parseEnvironment(const std::string& xml_text, const std::string& sou
 // each door sits in (orientation), joined spaces and status. Called by the reader; builders of environments
 // (the world generator) call it too. Throws InputError (naming `source_name`) when a portal lies on no wall.
 void deriveDoors(Environment* environment, const std::string& source_name);
+
+// Writes each of `environment.repairs` as "warning: <source>: <repair>" lines to `out`.
+void printRepairs(const Environment& environment, const std::string& source, std::ostream& out);
 
 // Writes the environment in the same schema (door status as <status> on its PORTAL segments).
 std::string environmentToXml(const Environment& environment);
