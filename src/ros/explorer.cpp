@@ -61,7 +61,7 @@ ExplorerOptions readExplorerOptions(const ros::NodeHandle& nh) {
 Explorer::Explorer(ros::NodeHandle nh, const ExplorerOptions& options)
     : options_(options), policy_(options), tf_buffer_(ros::Duration(10.0)), tf_listener_(tf_buffer_) {
   map_subscriber_ = nh.subscribe("map", 1, &Explorer::onMap, this);
-  scan_subscriber_ = nh.subscribe("base_scan", 1, &Explorer::onScan, this);
+  scan_subscriber_ = nh.subscribe("scan", 1, &Explorer::onScan, this);
   command_publisher_ = nh.advertise<geometry_msgs::Twist>("cmd_vel", 1);
   done_publisher_ = nh.advertise<std_msgs::Bool>("exploration_done", 1, true);
   markers_publisher_ = nh.advertise<visualization_msgs::MarkerArray>("exploration_markers", 1, true);

@@ -10,7 +10,7 @@ int main(int argc, char** argv) {
     const hidden_rooms::ExplorerOptions options = hidden_rooms::readExplorerOptions(private_nh);
     hidden_rooms::Explorer explorer(nh, options);
     ROS_INFO("explorer: exploring with the map on %s and the laser on %s (robot radius %.2f m)",
-             ros::names::resolve("map").c_str(), ros::names::resolve("base_scan").c_str(),
+             ros::names::resolve("map").c_str(), ros::names::resolve("scan").c_str(),
              options.planner.robot_radius);
     ros::spin();
   } catch (const hidden_rooms::common::InputError& error) {

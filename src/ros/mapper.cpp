@@ -15,7 +15,6 @@ namespace hidden_rooms {
 const common::OptionTable<MapperOptions>& mapperNodeOptionTable() {
   using O = MapperOptions;
   static const common::OptionTable<O> table{
-      {"scan_topic", &O::scan_topic, "laser topic"},
       {"map_frame", &O::map_frame, "frame of the map", common::anyFinite(), true},
       {"odom_frame", &O::odom_frame, "frame of the odometry", common::anyFinite(), true},
       {"base_frame", &O::base_frame, "frame of the robot", common::anyFinite(), true},
@@ -59,7 +58,7 @@ Mapper::Mapper(ros::NodeHandle nh, const MapperOptions& options)
       mapper_(std::make_unique<mapping::RbpfMapper>(options.rbpf)),
       tf_buffer_(ros::Duration(30.0)),
       tf_listener_(tf_buffer_) {
-  scan_subscriber_ = nh.subscribe(options.scan_topic, 50, &Mapper::onScan, this);
+  scan_subscriber_ = nh.subscribe("scan", 50, &Mapper::onScan, this);
   map_publisher_ = nh.advertise<nav_msgs::OccupancyGrid>("map", 1, true);
   metadata_publisher_ = nh.advertise<nav_msgs::MapMetaData>("map_metadata", 1, true);
   if (options.publish_particles) particles_publisher_ = nh.advertise<geometry_msgs::PoseArray>("particles", 1);

@@ -23,7 +23,6 @@ namespace hidden_rooms {
 // Parameters of the mapper node (all private, ~name; see docs/ros_api.md and config/mapper.yaml).
 struct MapperOptions {
   mapping::RbpfMapperOptions rbpf;  // ~config_file (MRPT ini), ~seed
-  std::string scan_topic = "base_scan";
   std::string map_frame = "map";
   std::string odom_frame = "odom";
   std::string base_frame = "base_link";
@@ -45,7 +44,7 @@ std::vector<common::OptionDescription> mapperParameters();
 // ~config_file.
 MapperOptions readMapperOptions(const ros::NodeHandle& private_nh);
 
-// SLAM node over the core's RbpfMapper: each scan of `scan_topic` with the odometry (tf odom -> base_link at the
+// SLAM node over the core's RbpfMapper: each scan on `scan` with the odometry (tf odom -> base_link at the
 // scan's stamp) goes to MRPT's RBPF; publishes the map (latched), map_metadata, the particles and tf
 // map -> odom, and serves save_map. With a tf rate, map -> odom is republished from its own thread, so a long
 // filter update or map rendering (large maps) does not leave the tree without a recent map -> odom.
