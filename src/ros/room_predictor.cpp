@@ -1,5 +1,6 @@
 #include "hidden_rooms/ros/room_predictor.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 
@@ -9,6 +10,7 @@
 #include "hidden_rooms/common/input_error.h"
 #include "hidden_rooms/common/input_limits.h"
 #include "hidden_rooms/map3d/octomap_io.h"
+#include "hidden_rooms/prediction/door_at_point.h"
 #include "hidden_rooms/prediction/layout.h"
 #include "hidden_rooms/prediction/prediction_support.h"
 #include "hidden_rooms/ros/conversions.h"
@@ -23,7 +25,8 @@ const common::OptionTable<RoomPredictorOptions>& roomPredictorNodeOptionTable() 
       {"method", &O::method, "method of requests that name none, and of ~predict_on_map"},
       {"closed_doors_file", &O::closed_doors_file, "doors.yaml: the doors of requests that give none"},
       {"params_file", &O::params_file, "flat `name: number` overrides applied to every request"},
-      {"predict_on_map", &O::predict_on_map, "predict the file's doors on every new map (needs ~closed_doors_file)"},
+      {"predict_on_map", &O::predict_on_map,
+       "predict the node's doors on every new map (needs ~closed_doors_file or ~doors_from_clicks)"},
       {"publish_debug", &O::publish_debug, "add the layout analysis namespaces to predicted_rooms"},
       {"frame_id", &O::frame_id, "frame of the outputs when the map's header.frame_id is empty"},
       {"octomap_file", &O::octomap_file, "a 3D map as map source, sliced at start"},
@@ -34,6 +37,12 @@ const common::OptionTable<RoomPredictorOptions>& roomPredictorNodeOptionTable() 
       {"max_doors", &O::max_doors, "requests with more doors are refused", common::between(1, common::kMaxDoors)},
       {"max_map_cells", &O::max_map_cells, "maps with more cells (width x height) are refused",
        common::between(1, common::kMaxMapCells)},
+      {"doors_from_clicks", &O::doors_from_clicks,
+       "a point on clicked_point adds the door there, or removes the door clicked on, and predicts again"},
+      {"click_door_width", &O::click_door_width,
+       "metres: a clicked door's width when the map shows no jambs and the node has no doors", common::above(0)},
+      {"click_search_radius", &O::click_search_radius, "metres around a click where the door's wall is looked for",
+       common::above(0)},
   };
   return table;
 }
@@ -45,8 +54,8 @@ std::vector<common::OptionDescription> roomPredictorParameters() {
 RoomPredictorOptions readRoomPredictorOptions(const ros::NodeHandle& private_nh) {
   RoomPredictorOptions options;
   readParameters(private_nh, roomPredictorNodeOptionTable(), &options);
-  if (options.predict_on_map && options.closed_doors_file.empty())
-    throw common::InputError(private_nh.getNamespace(), "~predict_on_map needs ~closed_doors_file");
+  if (options.predict_on_map && options.closed_doors_file.empty() && !options.doors_from_clicks)
+    throw common::InputError(private_nh.getNamespace(), "~predict_on_map needs ~closed_doors_file or ~doors_from_clicks");
   return options;
 }
 
@@ -63,6 +72,9 @@ RoomPredictorNode::RoomPredictorNode(ros::NodeHandle nh, const RoomPredictorOpti
   markers_publisher_ = nh.advertise<visualization_msgs::MarkerArray>("predicted_rooms", 1, true);
   service_ = nh.advertiseService("predict_rooms", &RoomPredictorNode::predictRooms, this);
   map_subscriber_ = nh.subscribe("map", 1, &RoomPredictorNode::receiveMap, this);
+  save_doors_service_ = nh.advertiseService("save_doors", &RoomPredictorNode::saveDoors, this);
+  if (options_.doors_from_clicks)
+    click_subscriber_ = nh.subscribe("clicked_point", 10, &RoomPredictorNode::receiveClick, this);
   if (!options_.octomap_out.empty()) {
     const std::filesystem::path folder = std::filesystem::path(options_.octomap_out).parent_path();
     std::error_code error;
@@ -83,14 +95,99 @@ RoomPredictorNode::RoomPredictorNode(ros::NodeHandle nh, const RoomPredictorOpti
 
 void RoomPredictorNode::receiveMap(const nav_msgs::OccupancyGrid::ConstPtr& map) {
   latest_map_ = map;
-  if (!options_.predict_on_map) return;
-  PredictRooms::Request request;  // the configured doors and method over this map
+  if (options_.predict_on_map && default_doors_ && !default_doors_->doors.empty()) predictAndLog("new map");
+}
+
+void RoomPredictorNode::predictAndLog(const std::string& why) {
+  PredictRooms::Request request;  // the node's doors and method over the latest map
   PredictRooms::Response response;
   predictRooms(request, response);
   if (response.success)
-    ROS_INFO("room_predictor: new map: %s", response.message.c_str());
+    ROS_INFO("room_predictor: %s: %s", why.c_str(), response.message.c_str());
   else
-    ROS_WARN("room_predictor: new map: %s", response.message.c_str());
+    ROS_WARN("room_predictor: %s: %s", why.c_str(), response.message.c_str());
+}
+
+void RoomPredictorNode::receiveClick(const geometry_msgs::PointStamped::ConstPtr& click) {
+  if (latest_map_ == nullptr) {
+    ROS_WARN("room_predictor: click ignored: no map received on %s yet", map_topic_.c_str());
+    return;
+  }
+  const std::string frame = latest_map_->header.frame_id.empty() ? options_.frame_id : latest_map_->header.frame_id;
+  if (click->header.frame_id != frame) {
+    ROS_WARN("room_predictor: click ignored: it is in frame '%s', the map in '%s' (set rviz's fixed frame to '%s')",
+             click->header.frame_id.c_str(), frame.c_str(), frame.c_str());
+    return;
+  }
+  if (!default_doors_) {
+    default_doors_ = common::DoorsFile();
+    default_doors_->frame = frame;
+  }
+  std::vector<common::MapDoor>& doors = default_doors_->doors;
+  const common::Point2 point(click->point.x, click->point.y);
+  // A click on a door removes it: within half its width of its centre (and at least half a metre).
+  const auto clicked = std::find_if(doors.begin(), doors.end(), [&](const common::MapDoor& door) {
+    return (door.position - point).norm() <= std::max(0.5, 0.5 * door.width);
+  });
+  if (clicked != doors.end()) {
+    ROS_INFO("room_predictor: door %d removed; %zu doors left", clicked->id, doors.size() - 1);
+    doors.erase(clicked);
+    if (doors.empty()) {
+      visualization_msgs::MarkerArray cleared;
+      cleared.markers.resize(1);
+      cleared.markers[0].action = visualization_msgs::Marker::DELETEALL;
+      markers_publisher_.publish(cleared);
+      return;
+    }
+  } else {
+    if (static_cast<int>(doors.size()) >= options_.max_doors) {
+      ROS_WARN("room_predictor: click ignored: the node has ~max_doors (%d) doors", options_.max_doors);
+      return;
+    }
+    prediction::DoorAtPointOptions door_options;
+    door_options.search_radius = options_.click_search_radius;
+    door_options.default_width = options_.click_door_width;
+    if (!doors.empty()) {  // as wide as the doors already known (their median)
+      std::vector<double> widths;
+      for (const common::MapDoor& door : doors) widths.push_back(door.width);
+      std::nth_element(widths.begin(), widths.begin() + widths.size() / 2, widths.end());
+      door_options.default_width = widths[widths.size() / 2];
+    }
+    std::string problem;
+    const common::OccupancyGrid map = fromRos(*latest_map_);
+    std::optional<common::MapDoor> door = prediction::doorAtPoint(map, point, door_options, &problem);
+    if (!door) {
+      ROS_WARN("room_predictor: no door added at (%.2f, %.2f): %s", point.x(), point.y(), problem.c_str());
+      return;
+    }
+    door->id = 1;
+    for (const common::MapDoor& other : doors) door->id = std::max(door->id, other.id + 1);
+    ROS_INFO("room_predictor: door %d added at (%.2f, %.2f), %.2f m wide, along %s; %zu doors", door->id,
+             door->position.x(), door->position.y(), door->width,
+             door->orientation == common::DoorOrientation::kAlongX ? "x" : "y", doors.size() + 1);
+    doors.push_back(*door);
+  }
+  predictAndLog("doors clicked");
+}
+
+bool RoomPredictorNode::saveDoors(SaveDoors::Request& request, SaveDoors::Response& response) {
+  response = SaveDoors::Response();
+  try {
+    if (!default_doors_ || default_doors_->doors.empty())
+      throw common::InputError("save_doors", "the node has no doors (no ~closed_doors_file, no door clicked)");
+    if (request.path.empty()) throw common::InputError("save_doors", "the request names no file");
+    const std::filesystem::path folder = std::filesystem::path(request.path).parent_path();
+    std::error_code error;
+    if (!folder.empty()) std::filesystem::create_directories(folder, error);
+    if (error) throw common::InputError(request.path, "its folder cannot be created: " + error.message());
+    common::saveDoors(*default_doors_, request.path);
+    response.success = true;
+    response.message = "wrote " + std::to_string(default_doors_->doors.size()) + " doors to " + request.path;
+  } catch (const std::exception& error) {
+    response.success = false;
+    response.message = error.what();
+  }
+  return true;
 }
 
 bool RoomPredictorNode::predictRooms(PredictRooms::Request& request, PredictRooms::Response& response) {
@@ -131,7 +228,8 @@ void RoomPredictorNode::predict(const PredictRooms::Request& request, PredictRoo
                                                          "', the map in '" + frame + "'");
     core.doors = *default_doors_;
   } else {
-    throw common::InputError("doors", "the request has no doors and the node has no ~closed_doors_file");
+    throw common::InputError("doors", "the request has no doors and the node has none (no ~closed_doors_file, "
+                                      "no door clicked on clicked_point)");
   }
   if (core.doors.doors.empty()) throw common::InputError("doors", "no closed doors to predict");
   prediction::checkDoorsInsideMap(core.map, core.doors);

@@ -2,7 +2,9 @@
 // predict_rooms_offline, publishes its overlays latched, answers bad requests with success = false and a clear
 // message, and keeps serving; predict_rooms_client saves the same files as the offline command.
 #include <gtest/gtest.h>
+#include <geometry_msgs/PointStamped.h>
 #include <hidden_rooms/PredictRooms.h>
+#include <hidden_rooms/SaveDoors.h>
 #include <nav_msgs/OccupancyGrid.h>
 #include <ros/ros.h>
 #include <visualization_msgs/MarkerArray.h>
@@ -12,12 +14,14 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <optional>
 #include <set>
 #include <sstream>
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "hidden_rooms/common/doors_file.h"
 #include "hidden_rooms/map3d/octomap_io.h"
 #include "hidden_rooms/prediction/prediction_support.h"
 #include "hidden_rooms/ros/conversions.h"
@@ -351,6 +355,81 @@ TEST(RoomPredictor, BadRequestsFailWithAMessageAndTheNodeKeepsServing) {
   PredictRooms again;
   ASSERT_TRUE(call(&again, "/no_map/predict_rooms"));  // the other node is alive too
   EXPECT_FALSE(again.response.success);
+}
+
+// The node's doors, as save_doors writes them; nullopt when the call fails.
+std::optional<hidden_rooms::common::DoorsFile> savedDoors(const std::string& path) {
+  hidden_rooms::SaveDoors save;
+  save.request.path = path;
+  if (!ros::service::waitForService("save_doors", ros::Duration(30.0)) || !ros::service::call("save_doors", save) ||
+      !save.response.success)
+    return std::nullopt;
+  return hidden_rooms::common::loadDoors(path);
+}
+
+// Waits up to 10 s for the node to have `count` doors.
+std::optional<hidden_rooms::common::DoorsFile> waitForDoors(const std::string& path, size_t count) {
+  for (int attempt = 0; attempt < 100; ++attempt) {
+    const auto doors = savedDoors(path);
+    if (doors && doors->doors.size() == count) return doors;
+    ros::Duration(0.1).sleep();
+  }
+  return savedDoors(path);
+}
+
+// Runs last: it changes the node's doors.
+TEST(RoomPredictor, ClickedPointsRemoveAndAddDoorsThatSaveDoorsWrites) {
+  REQUIRE_CASE();
+  const hidden_rooms::common::DoorsFile file = hidden_rooms::common::loadDoors(caseDir() + "/doors.yaml");
+  const hidden_rooms::common::MapDoor first = file.doors.front();
+  const std::string path = testing_util::makeTempDir("room_predictor_doors") + "/new/folder/doors.yaml";
+  ros::NodeHandle nh;
+  ros::Publisher clicks = nh.advertise<geometry_msgs::PointStamped>("clicked_point", 10);
+  for (int attempt = 0; attempt < 100 && clicks.getNumSubscribers() == 0; ++attempt) ros::Duration(0.1).sleep();
+  ASSERT_GT(clicks.getNumSubscribers(), 0u);
+  auto click = [&](const hidden_rooms::common::Point2& point, const std::string& frame) {
+    geometry_msgs::PointStamped message;
+    message.header.frame_id = frame;
+    message.header.stamp = ros::Time::now();
+    message.point.x = point.x();
+    message.point.y = point.y();
+    clicks.publish(message);
+  };
+  // A click on a door removes it.
+  click(first.position, "map");
+  auto doors = waitForDoors(path, file.doors.size() - 1);
+  ASSERT_TRUE(doors);
+  ASSERT_EQ(doors->doors.size(), file.doors.size() - 1);
+  EXPECT_EQ(doors->frame, "map");
+  // A click 0.2 m beside where it was adds it back, with a new id, on its wall, as wide as the other doors.
+  const hidden_rooms::common::Point2 along =
+      first.orientation == hidden_rooms::common::DoorOrientation::kAlongX ? hidden_rooms::common::Point2(1, 0)
+                                                                          : hidden_rooms::common::Point2(0, 1);
+  click(first.position + 0.2 * along, "map");
+  doors = waitForDoors(path, file.doors.size());
+  ASSERT_TRUE(doors);
+  ASSERT_EQ(doors->doors.size(), file.doors.size());
+  const hidden_rooms::common::MapDoor& added = doors->doors.back();
+  EXPECT_EQ(added.id, 16);
+  EXPECT_EQ(added.orientation, first.orientation);
+  EXPECT_LT((added.position - first.position).norm(), 0.3);
+  EXPECT_GT(added.width, 1.0);  // the benchmark's doors are 1.3 to 2 m wide
+  // The node predicts on its doors: an empty request gets all of them.
+  PredictRooms service;
+  ASSERT_TRUE(call(&service));
+  EXPECT_TRUE(service.response.success) << service.response.message;
+  EXPECT_EQ(service.response.rooms.size(), file.doors.size());
+  // A click in another frame than the map's, or far from any wall, changes nothing.
+  click(first.position + 0.2 * along, "odom");
+  click(hidden_rooms::common::Point2(-1000.0, -1000.0), "map");
+  ros::Duration(1.0).sleep();
+  doors = savedDoors(path);
+  ASSERT_TRUE(doors);
+  EXPECT_EQ(doors->doors.size(), file.doors.size());
+  hidden_rooms::SaveDoors nameless;
+  ASSERT_TRUE(ros::service::call("save_doors", nameless));
+  EXPECT_FALSE(nameless.response.success);
+  EXPECT_NE(nameless.response.message.find("names no file"), std::string::npos) << nameless.response.message;
 }
 
 }  // namespace

@@ -6,7 +6,9 @@
 #include <string>
 #include <vector>
 
+#include <geometry_msgs/PointStamped.h>
 #include <hidden_rooms/PredictRooms.h>
+#include <hidden_rooms/SaveDoors.h>
 #include <nav_msgs/OccupancyGrid.h>
 #include <ros/ros.h>
 
@@ -32,6 +34,11 @@ struct RoomPredictorOptions {
   double octomap_z_max = 2.0;      // metres
   std::string octomap_out;         // after each prediction, the completed map extruded to this .ot/.bt; "" = off
   double octomap_height = 2.5;     // metres, height of the extruded walls
+  // Doors marked in rviz: a point published on `clicked_point` ("Publish Point" tool) adds the door there, or
+  // removes the door clicked on, and predicts again.
+  bool doors_from_clicks = true;
+  double click_door_width = 0.9;     // metres: a clicked door's width when the map shows no jambs and no door is known
+  double click_search_radius = 1.0;  // metres around the click where the door's wall is looked for
   // Requests beyond these are refused (bounded answer times and memory).
   int max_doors = common::kMaxDoors;
   int max_map_cells = static_cast<int>(common::kMaxMapCells);  // 5000 x 5000 cells: 250 m x 250 m at 0.05 m
@@ -41,7 +48,7 @@ struct RoomPredictorOptions {
 const common::OptionTable<RoomPredictorOptions>& roomPredictorNodeOptionTable();
 std::vector<common::OptionDescription> roomPredictorParameters();
 // Reads the options from the private node handle. Throws InputError naming the first bad parameter, or for
-// ~predict_on_map without doors.
+// ~predict_on_map without a way to get doors (a doors file or clicks).
 RoomPredictorOptions readRoomPredictorOptions(const ros::NodeHandle& private_nh);
 
 // Serves `predict_rooms` (PredictRooms) over the latest map of `map` or the request's own map, and publishes
@@ -54,14 +61,20 @@ class RoomPredictorNode {
 
   // The service: never throws; every failure is success = false with a message.
   bool predictRooms(PredictRooms::Request& request, PredictRooms::Response& response);
+  // save_doors: writes the node's doors; never throws.
+  bool saveDoors(SaveDoors::Request& request, SaveDoors::Response& response);
 
  private:
   void receiveMap(const nav_msgs::OccupancyGrid::ConstPtr& map);
+  // A click on clicked_point: adds or removes a door (see RoomPredictorOptions::doors_from_clicks).
+  void receiveClick(const geometry_msgs::PointStamped::ConstPtr& click);
+  // Predicts the node's doors with its method on the latest map and logs the outcome (`why`: what triggered it).
+  void predictAndLog(const std::string& why);
   // Predicts and publishes; throws InputError for an unusable request.
   void predict(const PredictRooms::Request& request, PredictRooms::Response* response);
 
   RoomPredictorOptions options_;
-  std::optional<common::DoorsFile> default_doors_;
+  std::optional<common::DoorsFile> default_doors_;  // the doors of requests without doors: file, then clicks
   std::map<std::string, double> file_parameters_;
   nav_msgs::OccupancyGrid::ConstPtr latest_map_;
   std::string map_topic_;
@@ -69,6 +82,8 @@ class RoomPredictorNode {
   ros::Publisher predicted_map_publisher_;
   ros::Publisher markers_publisher_;
   ros::ServiceServer service_;
+  ros::ServiceServer save_doors_service_;
+  ros::Subscriber click_subscriber_;
   ros::WallTimer octomap_timer_;
 };
 
