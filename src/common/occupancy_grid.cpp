@@ -180,16 +180,17 @@ OccupancyGrid loadMap(const std::string& yaml_path) {
   return gridFromImage(image, metadata);
 }
 
+OccupancyGrid trinary(const OccupancyGrid& grid) {
+  OccupancyGrid result = grid;
+  result.cells = cv::Mat_<int8_t>(grid.cells.size(), OccupancyGrid::kUnknown);
+  result.cells.setTo(OccupancyGrid::kFree, grid.cells >= 0 & grid.cells <= kSaveFreeMax);
+  result.cells.setTo(OccupancyGrid::kOccupied, grid.cells >= kSaveOccupiedMin);
+  return result;
+}
+
 std::string saveMap(const OccupancyGrid& grid, const std::string& prefix, const std::string& image_extension) {
   if (grid.empty()) throw InputError(prefix, "cannot save an empty map");
-  cv::Mat1b image(grid.cells.size());
-  for (int row = 0; row < image.rows; ++row)
-    for (int col = 0; col < image.cols; ++col) {
-      const int value = grid.cells(row, col);
-      if (value >= 0 && value <= kSaveFreeMax) image(row, col) = 254;
-      else if (value >= kSaveOccupiedMin) image(row, col) = 0;
-      else image(row, col) = 205;
-    }
+  const cv::Mat1b image = trinary(grid).toGreyImage();
   const std::filesystem::path yaml_path = prefix + ".yaml";
   const std::filesystem::path image_path = prefix + image_extension;
   writeImage(image_path.string(), image);

@@ -155,6 +155,13 @@ visualization_msgs::MarkerArray toMarkers(const common::OccupancyGrid& map, cons
     }
   }
   if (!door_lines.points.empty()) array.markers.push_back(door_lines);
+  // What the colours mean, centred above the map.
+  Marker legend = newMarker("legend", 0, Marker::TEXT_VIEW_FACING, frame_id, stamp);
+  legend.pose.position = imagePoint(map, 0.5 * map.width(), -2.0 / map.resolution, 0.5);
+  legend.scale.z = 1.0;  // metres: text height
+  legend.text = "coloured: predicted room (door id, area)   red bar: closed door   grey bar: door not placed\n"
+                "map: white free, black wall, grey unexplored";
+  array.markers.push_back(legend);
   return array;
 }
 

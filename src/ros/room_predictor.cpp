@@ -43,6 +43,7 @@ const common::OptionTable<RoomPredictorOptions>& roomPredictorNodeOptionTable() 
        "metres: a clicked door's width when the map shows no jambs and the node has no doors", common::above(0)},
       {"click_search_radius", &O::click_search_radius, "metres around a click where the door's wall is looked for",
        common::above(0)},
+      {"view_frame", &O::view_frame, "tf frame at the centre of the map's known cells, for rviz's view"},
   };
   return table;
 }
@@ -95,7 +96,34 @@ RoomPredictorNode::RoomPredictorNode(ros::NodeHandle nh, const RoomPredictorOpti
 
 void RoomPredictorNode::receiveMap(const nav_msgs::OccupancyGrid::ConstPtr& map) {
   latest_map_ = map;
+  if (!options_.view_frame.empty()) publishViewFrame(*map);
   if (options_.predict_on_map && default_doors_ && !default_doors_->doors.empty()) predictAndLog("new map");
+}
+
+void RoomPredictorNode::publishViewFrame(const nav_msgs::OccupancyGrid& map) {
+  constexpr double kMoveDistance = 2.0;  // metres: a growing SLAM map moves the view only now and then
+  const auto& info = map.info;
+  int min_col = static_cast<int>(info.width), max_col = -1, min_row = static_cast<int>(info.height), max_row = -1;
+  for (int row = 0; row < static_cast<int>(info.height); ++row)
+    for (int col = 0; col < static_cast<int>(info.width); ++col)
+      if (map.data[static_cast<size_t>(row) * info.width + col] >= 0) {
+        min_col = std::min(min_col, col), max_col = std::max(max_col, col);
+        min_row = std::min(min_row, row), max_row = std::max(max_row, row);
+      }
+  if (max_col < 0) return;
+  // The map message's rows run up from its origin; a rotated origin is refused by predictions, ignored here.
+  const common::Point2 centre(info.origin.position.x + 0.5 * (min_col + max_col + 1) * info.resolution,
+                              info.origin.position.y + 0.5 * (min_row + max_row + 1) * info.resolution);
+  if (view_centre_ && (centre - *view_centre_).norm() < kMoveDistance) return;
+  view_centre_ = centre;
+  geometry_msgs::TransformStamped transform;
+  transform.header.stamp = ros::Time::now();
+  transform.header.frame_id = map.header.frame_id.empty() ? options_.frame_id : map.header.frame_id;
+  transform.child_frame_id = options_.view_frame;
+  transform.transform.translation.x = centre.x();
+  transform.transform.translation.y = centre.y();
+  transform.transform.rotation.w = 1.0;
+  view_broadcaster_.sendTransform(transform);
 }
 
 void RoomPredictorNode::predictAndLog(const std::string& why) {
@@ -154,7 +182,7 @@ void RoomPredictorNode::receiveClick(const geometry_msgs::PointStamped::ConstPtr
       door_options.default_width = widths[widths.size() / 2];
     }
     std::string problem;
-    const common::OccupancyGrid map = fromRos(*latest_map_);
+    const common::OccupancyGrid map = common::trinary(fromRos(*latest_map_));
     std::optional<common::MapDoor> door = prediction::doorAtPoint(map, point, door_options, &problem);
     if (!door) {
       ROS_WARN("room_predictor: no door added at (%.2f, %.2f): %s", point.x(), point.y(), problem.c_str());
@@ -218,7 +246,7 @@ void RoomPredictorNode::predict(const PredictRooms::Request& request, PredictRoo
   const std::string frame = map_message.header.frame_id.empty() ? options_.frame_id : map_message.header.frame_id;
 
   prediction::PredictionRequest core;
-  core.map = fromRos(map_message);
+  core.map = common::trinary(fromRos(map_message));  // as map_saver would save it: predictions equal offline ones
   prediction::checkUsableMap(core.map);
   if (!request.doors.empty()) {
     core.doors = fromRos(request.doors, frame);

@@ -195,17 +195,15 @@ Simulator::Simulator(ros::NodeHandle nh, const SimulatorOptions& options) : opti
   set_door_service_ = nh.advertiseService("set_door", &Simulator::onSetDoor, this);
   footprint_publisher_ = nh.advertise<geometry_msgs::PolygonStamped>("footprint", 1, true);
 
-  geometry_msgs::PolygonStamped footprint;  // stamp 0: valid at any time (rviz uses the latest transform)
-  footprint.header.frame_id = options.base_frame;
+  footprint_.header.frame_id = options.base_frame;
   const double half_length = 0.5 * options.simulation.robot.length, half_width = 0.5 * options.simulation.robot.width;
   for (const auto& [x, y] : {std::pair<double, double>{half_length, half_width}, {-half_length, half_width},
                              {-half_length, -half_width}, {half_length, -half_width}}) {
     geometry_msgs::Point32 corner;
     corner.x = static_cast<float>(x);
     corner.y = static_cast<float>(y);
-    footprint.polygon.points.push_back(corner);
+    footprint_.polygon.points.push_back(corner);
   }
-  footprint_publisher_.publish(footprint);
 
   std::vector<geometry_msgs::TransformStamped> fixed{
       toTransform(options.simulation.laser.mount, options.base_frame, options.laser_frame, now())};
@@ -262,6 +260,9 @@ void Simulator::publishOdometry() {
   ground_truth_publisher_.publish(
       toRos(simulation_->truePose(), simulation_->velocity(), options_.world_frame, options_.base_frame, stamp));
   tf_broadcaster_.sendTransform(toTransform(odometry, options_.odom_frame, options_.base_frame, stamp));
+  // Stamped with the pose it goes with: rviz places a polygon once, at its stamp's transform.
+  footprint_.header.stamp = stamp;
+  footprint_publisher_.publish(footprint_);
 }
 
 void Simulator::onCommand(const geometry_msgs::Twist::ConstPtr& command) {

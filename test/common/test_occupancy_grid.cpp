@@ -159,5 +159,15 @@ TEST(OccupancyGrid, RefusesToSaveAnEmptyMap) {
   EXPECT_THROW(saveMap(OccupancyGrid(), testing::makeTempDir("grid_empty") + "/empty"), InputError);
 }
 
+TEST(OccupancyGrid, TrinaryIsWhatMapSaverSavesAndMapServerReadsBack) {
+  OccupancyGrid probabilities;
+  probabilities.cells = (cv::Mat_<int8_t>(1, 8) << -1, 0, 19, 20, 50, 64, 65, 100);
+  const cv::Mat_<int8_t> expected = (cv::Mat_<int8_t>(1, 8) << -1, 0, 0, -1, -1, -1, 100, 100);
+  EXPECT_EQ(cv::countNonZero(trinary(probabilities).cells != expected), 0) << cv::Mat(trinary(probabilities).cells);
+  const std::string prefix = testing::makeTempDir("grid_trinary") + "/map";
+  saveMap(probabilities, prefix);
+  EXPECT_EQ(cv::countNonZero(loadMap(prefix + ".yaml").cells != trinary(probabilities).cells), 0);
+}
+
 }  // namespace
 }  // namespace hidden_rooms::common

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include <geometry_msgs/PolygonStamped.h>
 #include <geometry_msgs/Twist.h>
 #include <gtest/gtest.h>
 #include <hidden_rooms/SetDoor.h>
@@ -30,6 +31,8 @@ class SimulatorTest : public ::testing::Test {
     odom_subscriber_ = nh_.subscribe<nav_msgs::Odometry>("odom", 100, [this](const nav_msgs::Odometry::ConstPtr& m) {
       odom_.push_back(m);
     });
+    footprint_subscriber_ = nh_.subscribe<geometry_msgs::PolygonStamped>(
+        "footprint", 100, [this](const geometry_msgs::PolygonStamped::ConstPtr& m) { footprints_.push_back(m); });
     truth_subscriber_ = nh_.subscribe<nav_msgs::Odometry>("base_pose_ground_truth", 100,
                                                          [this](const nav_msgs::Odometry::ConstPtr& m) { truth_ = m; });
     command_publisher_ = nh_.advertise<geometry_msgs::Twist>("cmd_vel", 10);
@@ -78,16 +81,18 @@ class SimulatorTest : public ::testing::Test {
   }
 
   ros::NodeHandle nh_;
-  ros::Subscriber scan_subscriber_, odom_subscriber_, truth_subscriber_;
+  ros::Subscriber scan_subscriber_, odom_subscriber_, truth_subscriber_, footprint_subscriber_;
   ros::Publisher command_publisher_;
   std::vector<sensor_msgs::LaserScan::ConstPtr> scans_;
   std::vector<nav_msgs::Odometry::ConstPtr> odom_;
+  std::vector<geometry_msgs::PolygonStamped::ConstPtr> footprints_;
   nav_msgs::Odometry::ConstPtr truth_;
 };
 
 TEST_F(SimulatorTest, PublishesAtItsRatesOnSimulatedTime) {
   scans_.clear();
   odom_.clear();
+  footprints_.clear();
   ASSERT_TRUE(waitFor([&] {
     return scans_.size() >= 2 && scans_.back()->header.stamp.toSec() - scans_.front()->header.stamp.toSec() >= 3.0;
   }, 30.0));
@@ -104,6 +109,11 @@ TEST_F(SimulatorTest, PublishesAtItsRatesOnSimulatedTime) {
   EXPECT_EQ(odom_.back()->child_frame_id, "base_link");
   EXPECT_EQ(truth_->header.frame_id, "world");
   EXPECT_GT(ros::Time::now().toSec(), 0.0);  // /clock drives this node's time
+  // The footprint comes with each odometry message and its stamp (rviz places it at that stamp's pose).
+  ASSERT_GE(footprints_.size(), 2u);
+  EXPECT_GT(footprints_.back()->header.stamp, footprints_.front()->header.stamp);
+  EXPECT_EQ(footprints_.back()->header.frame_id, "base_link");
+  EXPECT_EQ(footprints_.back()->polygon.points.size(), 4u);
 }
 
 TEST_F(SimulatorTest, RangesEqualAnalyticDistancesAndSetDoorChangesTheScan) {

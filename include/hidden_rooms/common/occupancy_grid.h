@@ -60,6 +60,10 @@ std::string mapImagePath(const std::string& yaml_path);
 // Converts a greyscale image with map_server's rules.
 OccupancyGrid gridFromImage(const cv::Mat& image, const MapMetadata& metadata);
 
+// The grid as map_saver saves it and map_server reads it back: cells <= 19 free (0), >= 65 occupied (100), the
+// others unknown (-1). SLAM maps (the mapper's, cartographer's) hold occupancy probabilities in between.
+OccupancyGrid trinary(const OccupancyGrid& grid);
+
 // Writes `PREFIX.yaml` and `PREFIX.pgm` as map_saver does (trinary: 254 free, 0 occupied, 205 unknown;
 // cells <= 19 are free, >= 65 occupied), the image as `PREFIX` + `image_extension` (".png": compressed). Returns
 // the yaml path. Throws InputError when it cannot write.

@@ -11,6 +11,7 @@
 #include <hidden_rooms/SaveDoors.h>
 #include <nav_msgs/OccupancyGrid.h>
 #include <ros/ros.h>
+#include <tf2_ros/static_transform_broadcaster.h>
 
 #include "hidden_rooms/common/doors_file.h"
 #include "hidden_rooms/common/input_limits.h"
@@ -39,6 +40,9 @@ struct RoomPredictorOptions {
   bool doors_from_clicks = true;
   double click_door_width = 0.9;     // metres: a clicked door's width when the map shows no jambs and no door is known
   double click_search_radius = 1.0;  // metres around the click where the door's wall is looked for
+  // A tf frame at the centre of the latest map's known cells (static, child of the map's frame): the shipped rviz
+  // views look at it, so they centre on any map; "" = none.
+  std::string view_frame = "map_view";
   // Requests beyond these are refused (bounded answer times and memory).
   int max_doors = common::kMaxDoors;
   int max_map_cells = static_cast<int>(common::kMaxMapCells);  // 5000 x 5000 cells: 250 m x 250 m at 0.05 m
@@ -68,6 +72,8 @@ class RoomPredictorNode {
   void receiveMap(const nav_msgs::OccupancyGrid::ConstPtr& map);
   // A click on clicked_point: adds or removes a door (see RoomPredictorOptions::doors_from_clicks).
   void receiveClick(const geometry_msgs::PointStamped::ConstPtr& click);
+  // Moves ~view_frame to the centre of the map's known cells when it moved by more than a few metres.
+  void publishViewFrame(const nav_msgs::OccupancyGrid& map);
   // Predicts the node's doors with its method on the latest map and logs the outcome (`why`: what triggered it).
   void predictAndLog(const std::string& why);
   // Predicts and publishes; throws InputError for an unusable request.
@@ -84,6 +90,8 @@ class RoomPredictorNode {
   ros::ServiceServer service_;
   ros::ServiceServer save_doors_service_;
   ros::Subscriber click_subscriber_;
+  tf2_ros::StaticTransformBroadcaster view_broadcaster_;
+  std::optional<common::Point2> view_centre_;  // where ~view_frame was last published
   ros::WallTimer octomap_timer_;
 };
 

@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include <geometry_msgs/PolygonStamped.h>
 #include <geometry_msgs/Twist.h>
 #include <hidden_rooms/SetDoor.h>
 #include <ros/ros.h>
@@ -83,6 +84,7 @@ class Simulator {
   ros::Publisher odom_publisher_;
   ros::Publisher ground_truth_publisher_;
   ros::Publisher footprint_publisher_;
+  geometry_msgs::PolygonStamped footprint_;  // the robot's outline in base_frame, re-stamped with each odometry
   ros::Subscriber command_subscriber_;
   ros::ServiceServer reset_service_;
   ros::ServiceServer set_door_service_;
