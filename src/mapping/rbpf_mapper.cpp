@@ -23,6 +23,7 @@
 
 #include "hidden_rooms/common/file_io.h"
 #include "hidden_rooms/common/input_error.h"
+#include "hidden_rooms/mapping/scan_matched_odometry.h"
 
 namespace hidden_rooms::mapping {
 
@@ -51,13 +52,12 @@ std::string mrptMessage(const std::exception& error) {
   return first;
 }
 
-// The odometry motion model from the ini's [MotionModel] section (MRPT has no loader for it).
-mrpt::obs::CActionRobotMovement2D::TMotionModelOptions readMotionModel(const mrpt::config::CConfigFileBase& ini,
-                                                                       const std::string& file) {
-  mrpt::obs::CActionRobotMovement2D::TMotionModelOptions model;
+// The odometry motion model from an ini section (MRPT has no loader for it); keys it lacks keep `model`'s values.
+mrpt::obs::CActionRobotMovement2D::TMotionModelOptions readMotionModel(
+    const mrpt::config::CConfigFileBase& ini, const std::string& file, const std::string& section = "MotionModel",
+    mrpt::obs::CActionRobotMovement2D::TMotionModelOptions model = {}) {
   model.modelSelection = mrpt::obs::CActionRobotMovement2D::mmGaussian;
   auto& g = model.gaussianModel;
-  const std::string section = "MotionModel";
   g.a1 = ini.read_double(section, "a1", g.a1);
   g.a2 = ini.read_double(section, "a2", g.a2);
   g.a3 = ini.read_double(section, "a3", g.a3);
@@ -66,7 +66,7 @@ mrpt::obs::CActionRobotMovement2D::TMotionModelOptions readMotionModel(const mrp
   g.minStdPHI = ini.read_double(section, "minStdPHI_deg", g.minStdPHI * 180.0 / kPi) * kPi / 180.0;
   for (double value : {g.a1, g.a2, g.a3, g.a4, g.minStdXY, g.minStdPHI})
     if (!std::isfinite(value) || value < 0.0)
-      throw common::InputError(file, "[MotionModel] values must be zero or positive");
+      throw common::InputError(file, "[" + section + "] motion model values must be zero or positive");
   return model;
 }
 
@@ -103,7 +103,10 @@ struct RbpfMapper::Impl {
   std::unique_ptr<mrpt::slam::CMetricMapBuilderRBPF> builder;
   mrpt::obs::CActionRobotMovement2D::TMotionModelOptions motion_model;
   bool started = false;
-  common::Pose2 last_odometry;
+  // The odometry the filter is fed: the robot's, or corrected by the scan-matching front-end ([ScanMatching]).
+  std::optional<ScanMatchedOdometry> front_end;
+  common::Pose2 last_odometry;      // the filter's odometry at the last scan
+  common::Pose2 last_raw_odometry;  // the robot's odometry at the last scan (map -> odom is relative to it)
   std::string config_file;
   int added = 0;
   int inserted = 0;
@@ -134,6 +137,15 @@ RbpfMapper::RbpfMapper(const RbpfMapperOptions& options) : impl_(std::make_uniqu
     if (!ini.sectionExists(options.section)) throw common::InputError(file, "no section [" + options.section + "]");
     construction.loadFromConfigFile(ini, options.section);
     impl_->motion_model = readMotionModel(ini, file);
+    const ScanMatchingOptions scan_matching = readScanMatchingOptions(ini, file);
+    if (scan_matching.enabled) {
+      // The prediction's noise: [ScanMatching]'s own a1 .. minStdPHI_deg, else the filter's [MotionModel]. MRPT's
+      // a2 is in metres per degree, a3 in degrees per metre.
+      const auto g = readMotionModel(ini, file, "ScanMatching", impl_->motion_model).gaussianModel;
+      impl_->front_end.emplace(scan_matching, ScanMatchedOdometry::MotionNoise{g.a1, g.a2 * 180.0 / kPi,
+                                                                               g.a3 * kPi / 180.0, g.a4, g.minStdXY,
+                                                                               g.minStdPHI});
+    }
     for (const auto& initializer : construction.mapsInitializers)
       if (const auto* grid = dynamic_cast<const mrpt::maps::COccupancyGridMap2D::TMapDefinition*>(initializer.get())) {
         impl_->published_insertion = readPublishedInsertion(ini, file, grid->insertionOpts);
@@ -192,10 +204,12 @@ bool RbpfMapper::addScan(const common::Pose2& odometry, const mrpt::obs::CObserv
   if (scan.getScanSize() == 0) throw common::InputError("scan", "has no beams");
   if (!finite(odometry)) throw common::InputError("scan", "non-finite odometry pose");
   Impl& impl = *impl_;
+  impl.last_raw_odometry = odometry;
+  const common::Pose2 filter_odometry = impl.front_end ? impl.front_end->correct(odometry, scan) : odometry;
   if (!impl.started) {
-    mrpt::poses::CPosePDFGaussian start(toMrpt(odometry));
+    mrpt::poses::CPosePDFGaussian start(toMrpt(filter_odometry));
     impl.builder->initialize(mrpt::maps::CSimpleMap(), &start);
-    impl.last_odometry = odometry;
+    impl.last_odometry = filter_odometry;
     impl.started = true;
   }
   auto observation = std::make_shared<mrpt::obs::CObservation2DRangeScan>(scan);
@@ -204,10 +218,10 @@ bool RbpfMapper::addScan(const common::Pose2& odometry, const mrpt::obs::CObserv
 
   // Odometry increment since the last scan, in the robot frame.
   mrpt::obs::CActionRobotMovement2D movement;
-  movement.computeFromOdometry(toMrpt(odometry) - toMrpt(impl.last_odometry), impl.motion_model);
+  movement.computeFromOdometry(toMrpt(filter_odometry) - toMrpt(impl.last_odometry), impl.motion_model);
   mrpt::obs::CActionCollection actions;
   actions.insert(movement);
-  impl.last_odometry = odometry;
+  impl.last_odometry = filter_odometry;
 
   try {
     impl.builder->processActionObservation(actions, frame);
@@ -263,7 +277,7 @@ common::Pose2 RbpfMapper::pose() const {
 }
 
 common::Pose2 RbpfMapper::mapToOdom() const {
-  return common::composePoses(pose(), common::invertPose(impl_->last_odometry));
+  return common::composePoses(pose(), common::invertPose(impl_->last_raw_odometry));
 }
 
 const mrpt::maps::COccupancyGridMap2D& RbpfMapper::Impl::publishedGrid() const {

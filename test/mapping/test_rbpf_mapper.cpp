@@ -20,6 +20,31 @@ namespace hidden_rooms::mapping {
 namespace {
 
 const std::string kConfig = std::string(HIDDEN_ROOMS_SOURCE_DIR) + "/config/rbpf.ini";
+const std::string kRealLaserConfig = std::string(HIDDEN_ROOMS_SOURCE_DIR) + "/config/rbpf_real_laser.ini";
+
+// Odometry that drifts as a real robot's can: 5 % too long and 2 degrees of heading per metre travelled.
+class DriftingOdometry {
+ public:
+  common::Pose2 next(const common::Pose2& odometry) {
+    if (!started_) {
+      started_ = true;
+      last_ = drifted_ = odometry;
+      return drifted_;
+    }
+    common::Pose2 step = common::composePoses(common::invertPose(last_), odometry);
+    last_ = odometry;
+    const double length = std::hypot(step.x, step.y);
+    step.x *= 1.05;
+    step.y *= 1.05;
+    step.yaw += 2.0 * 3.14159265358979323846 / 180.0 * length;
+    drifted_ = common::composePoses(drifted_, step);
+    return drifted_;
+  }
+
+ private:
+  bool started_ = false;
+  common::Pose2 last_, drifted_;
+};
 
 struct MappingRun {
   common::OccupancyGrid map;
@@ -30,16 +55,19 @@ struct MappingRun {
   std::vector<RbpfParticle> particles;
 };
 
-// Drives the robot (wander) through a world for `seconds` and maps it with scans at 10 Hz.
-MappingRun mapWorld(const std::string& world_file, double seconds, uint32_t mapper_seed) {
+// Drives the robot (wander) through a world for `seconds` and maps it with scans at 10 Hz, with the mapper's
+// ini `config`, from the simulator's odometry or (`drift`) that odometry drifting further.
+MappingRun mapWorld(const std::string& world_file, double seconds, uint32_t mapper_seed,
+                    const std::string& config = kConfig, bool drift = false) {
   const world::Environment environment = world::loadEnvironment(world_file);
   const world::RenderedEnvironment truth = world::renderEnvironment(environment, {});
   simulation::SimulationOptions options;
   options.seed = 3;
   simulation::Simulation simulation(simulation::worldFromEnvironment(environment, {}), options);
   RbpfMapperOptions mapper_options;
-  mapper_options.config_file = kConfig;
+  mapper_options.config_file = config;
   mapper_options.seed = mapper_seed;
+  DriftingOdometry drifting;
   RbpfMapper mapper(mapper_options);
   simulation::WanderDriver driver;
 
@@ -59,7 +87,8 @@ MappingRun mapWorld(const std::string& world_file, double seconds, uint32_t mapp
     if (k % 10 != 0) continue;
     simulation.scan(&scan.ranges);
     simulation.setCommand(driver.next(scan.ranges, laser));
-    if (mapper.addScan(simulation.odometryPose(), scan))
+    const common::Pose2 odometry = drift ? drifting.next(simulation.odometryPose()) : simulation.odometryPose();
+    if (mapper.addScan(odometry, scan))
       evaluation::markObservedCells(truth.map, simulation.laserPose(), scan, &observed);
     estimate.push_back(mapper.pose());
     true_poses.push_back(simulation.truePose());
@@ -132,6 +161,28 @@ TEST(RbpfMapper, StartsAtTheFirstOdometryPose) {
   EXPECT_THROW(mapper.addScan({0.0, 0.0, 0.0}, common::RangeScan()), common::InputError);
 }
 
+// The real-laser configuration: its scan-matching front-end takes out most of a drifting odometry's error, which
+// the same ini without the front-end (one particle following the odometry) keeps.
+TEST(RbpfMapper, TheScanMatchingFrontEndCorrectsDriftingOdometry) {
+  const std::string world = std::string(HIDDEN_ROOMS_SOURCE_DIR) + "/worlds/small_1.xml";
+  std::ifstream in(kRealLaserConfig);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const size_t at = text.find("enabled = 1");
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, 11, "enabled = 0");
+  const std::string without = testing::makeTempDir("rbpf_front_end") + "/without_front_end.ini";
+  std::ofstream(without) << text;
+  const MappingRun with_front_end = mapWorld(world, 90.0, 1, kRealLaserConfig, true);
+  const MappingRun odometry_only = mapWorld(world, 90.0, 1, without, true);
+  for (const MappingRun* run : {&with_front_end, &odometry_only})
+    std::printf("free IoU %.3f walls within 2 cells %.3f RMSE %.3f m relative %.4f per metre\n", run->quality.free_iou,
+                run->quality.walls_within_2_cells, run->trajectory.position_rmse,
+                run->trajectory.relative_translation_per_metre);
+  EXPECT_LT(with_front_end.trajectory.position_rmse, 0.5 * odometry_only.trajectory.position_rmse);
+  EXPECT_GT(with_front_end.quality.walls_within_2_cells, odometry_only.quality.walls_within_2_cells + 0.1);
+  EXPECT_GE(with_front_end.quality.free_iou, 0.8);
+}
+
 TEST(RbpfMapper, RejectsBadIniFiles) {
   const std::string dir = testing::makeTempDir("rbpf_ini");
   RbpfMapperOptions options;
@@ -168,6 +219,18 @@ TEST(RbpfMapper, RejectsBadIniFiles) {
     ADD_FAILURE() << "certainty 1.5 accepted";
   } catch (const common::InputError& error) {
     EXPECT_NE(std::string(error.what()).find("PublishedMap"), std::string::npos) << error.what();
+  }
+
+  // A front-end option out of its range.
+  text.replace(text.find("maxFreenessUpdateCertainty  = 1.5"), 33, freeness);
+  options.config_file = dir + "/front_end.ini";
+  std::ofstream(options.config_file) << text << "\n[ScanMatching]\nenabled = 1\nmin_goodness = 2\n";
+  try {
+    RbpfMapper mapper(options);
+    ADD_FAILURE() << "min_goodness 2 accepted";
+  } catch (const common::InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("[ScanMatching] min_goodness must be in [0, 1]"), std::string::npos)
+        << error.what();
   }
 }
 
