@@ -17,7 +17,8 @@ namespace hidden_rooms::mapping {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-constexpr int kMaxPoints = 360;        // scan points matched (evenly thinned beyond)
+constexpr int kMaxPoints = 360;
+constexpr size_t kMaxKeyframes = 20000;  // keyframes kept for map_radius (a 4 km path at 0.2 m)        // scan points matched (evenly thinned beyond)
 constexpr double kWindowSigmas = 3.0;  // the search window: the prediction's std. dev. times this, each way
 constexpr double kMaxWindow = 0.5;     // metres and ...
 constexpr double kMaxWindowAngle = 10.0 * kPi / 180.0;  // ... radians of the window at most
@@ -65,6 +66,7 @@ ScanMatchingOptions readScanMatchingOptions(const mrpt::config::CConfigFileBase&
   options.point_sigma = ini.read_double(section, "point_sigma", options.point_sigma);
   options.min_goodness = ini.read_double(section, "min_goodness", options.min_goodness);
   options.max_range = ini.read_double(section, "max_range", options.max_range);
+  options.map_radius = ini.read_double(section, "map_radius", options.map_radius);
   for (double value : {options.max_range, options.keyframe_distance, options.keyframe_angle_deg, options.resolution,
                        options.angle_step_deg, options.point_sigma})
     if (!std::isfinite(value) || value <= 0.0)
@@ -99,12 +101,22 @@ void ScanMatchedOdometry::rebuildLocalMap() {
   constexpr double kFloor = 0.01;      // likelihood of a point far from the map (clutter, people, new walls)
   double min_x = std::numeric_limits<double>::infinity(), min_y = min_x, max_x = -min_x, max_y = -min_x;
   std::vector<common::Point2> world;
-  for (const auto& keyframe : keyframes_)
+  // The last local_map_scans keyframes, and with map_radius every older one that near the newest.
+  const size_t recent_from = keyframes_.size() > static_cast<size_t>(options_.local_map_scans)
+                                 ? keyframes_.size() - options_.local_map_scans
+                                 : 0;
+  const common::Pose2& newest = keyframes_.back()->pose;
+  for (size_t k = 0; k < keyframes_.size(); ++k) {
+    const auto& keyframe = keyframes_[k];
+    if (k < recent_from &&
+        std::hypot(keyframe->pose.x - newest.x, keyframe->pose.y - newest.y) > options_.map_radius)
+      continue;
     for (const common::Point2& p : keyframe->points) {
       world.push_back(transformed(keyframe->pose, p));
       min_x = std::min(min_x, world.back().x()), max_x = std::max(max_x, world.back().x());
       min_y = std::min(min_y, world.back().y()), max_y = std::max(max_y, world.back().y());
     }
+  }
   local_map_ = std::make_unique<LocalMap>();
   if (world.empty()) return;
   const double r = options_.resolution;
@@ -145,7 +157,8 @@ common::Pose2 ScanMatchedOdometry::correct(const common::Pose2& odometry,
   const std::vector<common::Point2> points = robotFramePoints(scan, options_.max_range);
   auto addKeyframe = [&](const common::Pose2& pose) {
     keyframes_.push_back(std::make_shared<Keyframe>(Keyframe{points, pose}));
-    while (static_cast<int>(keyframes_.size()) > options_.local_map_scans) keyframes_.pop_front();
+    const size_t keep = options_.map_radius > 0.0 ? kMaxKeyframes : static_cast<size_t>(options_.local_map_scans);
+    while (keyframes_.size() > keep) keyframes_.pop_front();
     last_keyframe_ = pose;
     rebuildLocalMap();
   };

@@ -27,12 +27,15 @@ struct ScanMatchingOptions {
                                     // noisy (the likelihood field's width)
   double min_goodness = 0.5;        // a match with fewer points within 2 point_sigma of the map is not used
   double max_range = 20.0;          // metres: returns farther away are not matched (nor kept in the local map)
+  double map_radius = 0.0;          // metres: older keyframes this near the newest join the local map too
+                                    // (places seen before pull the pose back to where they were mapped); 0 = none
 };
 // Reads [ScanMatching] (absent: disabled). Throws InputError naming the file for a bad value.
 ScanMatchingOptions readScanMatchingOptions(const mrpt::config::CConfigFileBase& ini, const std::string& file);
 
 // Odometry corrected by scan matching, as laser odometry front-ends do before a SLAM back-end: each scan is
-// matched against a local map of the last keyframe scans by a correlative search (Olson, "Real-time correlative
+// matched against a local map of the last keyframe scans (and, with map_radius, of the places seen before near the
+// robot) by a correlative search (Olson, "Real-time correlative
 // scan matching", 2009) over a window of poses around the odometry's prediction, each pose weighted by the scan's
 // likelihood there times the prediction's Gaussian (the ini's motion model): the corrected pose is the mean of
 // that posterior. Along a corridor, where the scan fits equally well at many positions, the odometry keeps the
