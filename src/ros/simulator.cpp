@@ -44,8 +44,8 @@ std::vector<common::OptionDescription> explicitParameters() {
       {"closed_doors", "string", "\"" + defaults.closed_doors + "\"", "environment doors closed at start"},
       {"wall_thickness", "double", "0", "the walls as rendered, metres; 0 = the file's own, else 0.15"},
       {"seed", "int", std::to_string(simulation.seed), "random seed (laser noise, odometry error)"},
-      {"laser_field_of_view", "double", common::formatNumber(simulation.laser.field_of_view * 180.0 / kPi),
-       "degrees, centred on the laser's x axis"},
+      {"laser_field_of_view", "double", common::formatNumber(simulation.laser.field_of_view),
+       "radians (REP-103), centred on the laser's x axis"},
       {"laser_caster", "string", "\"" + std::string(simulation::toString(simulation.laser.caster)) + "\"",
        "box2d or grid"},
       {"laser_pose", "[x, y, yaw]", poseText(simulation.laser.mount), "base_link -> base_laser_link"},
@@ -131,12 +131,10 @@ SimulatorOptions readSimulatorOptions(const ros::NodeHandle& nh) {
   readParameters(nh, simulation::robotOptionTable(), &simulation.robot);
   simulation::LaserOptions& laser = simulation.laser;
   readParameters(nh, simulation::laserOptionTable(), &laser);
-  double field_of_view_degrees = laser.field_of_view * 180.0 / kPi;
-  readParameter(nh, "laser_field_of_view", &field_of_view_degrees);
-  if (!(field_of_view_degrees > 0.0 && field_of_view_degrees <= 360.0))
-    throw common::InputError("~laser_field_of_view",
-                             "must be in (0, 360] degrees, got " + common::formatNumber(field_of_view_degrees));
-  laser.field_of_view = field_of_view_degrees * kPi / 180.0;
+  readParameter(nh, "laser_field_of_view", &laser.field_of_view);
+  if (!(laser.field_of_view > 0.0 && laser.field_of_view <= 2.0 * kPi))
+    throw common::InputError("~laser_field_of_view", "must be in (0, 2 pi] radians (REP-103; 270 degrees is 4.712), got " +
+                                                         common::formatNumber(laser.field_of_view));
   readPose(nh, "laser_pose", &laser.mount);
   std::string caster = simulation::toString(laser.caster);
   readParameter(nh, "laser_caster", &caster);
