@@ -63,6 +63,7 @@ Mapper::Mapper(ros::NodeHandle nh, const MapperOptions& options)
   metadata_publisher_ = nh.advertise<nav_msgs::MapMetaData>("map_metadata", 1, true);
   if (options.publish_particles) particles_publisher_ = nh.advertise<geometry_msgs::PoseArray>("particles", 1);
   save_service_ = nh.advertiseService("save_map", &Mapper::onSaveMap, this);
+  dynamic_map_service_ = nh.advertiseService("dynamic_map", &Mapper::onDynamicMap, this);
   if (options.tf_publish_rate > 0.0) {
     ros::NodeHandle tf_nh(nh);
     tf_nh.setCallbackQueue(&tf_queue_);
@@ -174,6 +175,13 @@ void Mapper::publishTransform(const ros::Time& stamp) {
 }
 
 void Mapper::onTimer(const ros::TimerEvent&) { publishTransform(ros::Time::now()); }
+
+bool Mapper::onDynamicMap(nav_msgs::GetMap::Request&, nav_msgs::GetMap::Response& response) {
+  const common::OccupancyGrid grid = mapper_->map();
+  if (grid.empty()) return false;
+  response.map = toRos(grid, options_.map_frame, last_scan_stamp_);
+  return true;
+}
 
 bool Mapper::onSaveMap(hidden_rooms::SaveMap::Request& request, hidden_rooms::SaveMap::Response& response) {
   const common::OccupancyGrid grid = mapper_->map();

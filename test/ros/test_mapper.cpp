@@ -9,6 +9,7 @@
 #include <geometry_msgs/Twist.h>
 #include <gtest/gtest.h>
 #include <hidden_rooms/SaveMap.h>
+#include <nav_msgs/GetMap.h>
 #include <nav_msgs/MapMetaData.h>
 #include <nav_msgs/OccupancyGrid.h>
 #include <nav_msgs/Odometry.h>
@@ -154,6 +155,14 @@ TEST_F(MapperTest, MapsTheWorldPublishesTfAndSavesTheMap) {
   ASSERT_TRUE(ros::service::call("save_map", save));
   EXPECT_FALSE(save.response.success);
   EXPECT_FALSE(save.response.message.empty());
+
+  // dynamic_map (gmapping's convention): the map as it is now, in the map frame.
+  nav_msgs::GetMap dynamic;
+  ASSERT_TRUE(ros::service::call("dynamic_map", dynamic));
+  EXPECT_EQ(dynamic.response.map.header.frame_id, "map");
+  EXPECT_GE(dynamic.response.map.info.width, published.width());
+  EXPECT_GE(dynamic.response.map.info.height, published.height());
+  EXPECT_FLOAT_EQ(dynamic.response.map.info.resolution, 0.05f);
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include <hidden_rooms/SaveMap.h>
+#include <nav_msgs/GetMap.h>
 #include <ros/callback_queue.h>
 #include <ros/ros.h>
 #include <ros/spinner.h>
@@ -69,6 +70,8 @@ class Mapper {
   void publishTransform(const ros::Time& stamp);
   void onTimer(const ros::TimerEvent& event);
   bool onSaveMap(hidden_rooms::SaveMap::Request& request, hidden_rooms::SaveMap::Response& response);
+  // dynamic_map (gmapping's convention): the map as it is now; false (a failed call) before the first scan.
+  bool onDynamicMap(nav_msgs::GetMap::Request& request, nav_msgs::GetMap::Response& response);
 
   MapperOptions options_;
   std::unique_ptr<mapping::RbpfMapper> mapper_;
@@ -87,6 +90,7 @@ class Mapper {
   ros::Publisher metadata_publisher_;
   ros::Publisher particles_publisher_;
   ros::ServiceServer save_service_;
+  ros::ServiceServer dynamic_map_service_;
   // map -> odom after the last processed scan and the stamp it was last sent with: written by the scan callback,
   // read by the tf timer's thread.
   std::mutex transform_mutex_;
