@@ -35,11 +35,14 @@ constexpr double kSamePortalDistance = 2.0;
 constexpr double kFilledAreaTolerance = 0.1;
 constexpr double kAreaCheckPixels = 2.5e5;    // the outline's area in pixels of the raster measuring its fill
 constexpr double kAreaCheckMaxPixels = 1e6;   // pixels of that raster at most (a thin, long, slanted outline)
+constexpr double kAreaCheckMaxSide = 4000.0;  // pixels of its longer side at most (a sliver)
+constexpr double kAreaCheckMinPixels = 1000.0;  // an outline covering fewer pixels than this is not checked
 
-// The area (m2) that an even-odd fill of `polygon` covers, measured on a raster fine enough for the polygon's area.
+// The area (m2) that an even-odd fill of `polygon` covers, measured on a raster fine enough for the polygon's area;
+// `enclosed` itself for an outline too thin for a raster of bounded size to measure (a sliver).
 double evenOddArea(const common::Polygon& polygon) {
   const double enclosed = common::area(polygon);
-  if (enclosed <= 0.0) return 0.0;
+  if (!(enclosed > 0.0) || !std::isfinite(enclosed)) return enclosed;
   common::Point2 low = polygon.front(), high = polygon.front();
   for (const common::Point2& p : polygon) {
     low = low.cwiseMin(p);
@@ -47,7 +50,10 @@ double evenOddArea(const common::Polygon& polygon) {
   }
   const common::Point2 size = high - low;
   const double pixels_per_metre =
-      std::min(std::sqrt(kAreaCheckPixels / enclosed), std::sqrt(kAreaCheckMaxPixels / (size.x() * size.y())));
+      std::min({std::sqrt(kAreaCheckPixels / enclosed), std::sqrt(kAreaCheckMaxPixels / (size.x() * size.y())),
+                kAreaCheckMaxSide / std::max(size.x(), size.y())});
+  if (!std::isfinite(pixels_per_metre) || enclosed * pixels_per_metre * pixels_per_metre < kAreaCheckMinPixels)
+    return enclosed;
   const cv::Size raster(static_cast<int>(std::ceil(size.x() * pixels_per_metre)) + 2,
                         static_cast<int>(std::ceil(size.y() * pixels_per_metre)) + 2);
   constexpr int kShift = 8;  // vertices with 1/256 pixel precision
