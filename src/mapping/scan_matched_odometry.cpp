@@ -88,7 +88,7 @@ struct ScanMatchedOdometry::LocalMap {
   common::Point2 origin;  // metres: the corner of cell (0, 0)
   cv::Mat1f log_likelihood;
   float outside = 0.0f;   // the value off the map (the floor's)
-  cv::Mat1f near;         // 1 where a point is within 2 sigma of the map
+  cv::Mat1b near;         // non-zero where a point is within 2 sigma of the map
 };
 
 ScanMatchedOdometry::ScanMatchedOdometry(const ScanMatchingOptions& options, const MotionNoise& noise)
@@ -142,13 +142,11 @@ void ScanMatchedOdometry::rebuildLocalMap() {
   }
   local_map_->outside = static_cast<float>(std::log(kFloor));
   local_map_->log_likelihood.create(rows, cols);
-  local_map_->near.create(rows, cols);
+  local_map_->near = distance <= 2.0 * sigma_cells;
   for (int row = 0; row < rows; ++row)
     for (int col = 0; col < cols; ++col) {
-      const float d = distance(row, col);
-      const int k = static_cast<int>(d * kSteps);
+      const int k = static_cast<int>(distance(row, col) * kSteps);
       local_map_->log_likelihood(row, col) = k < table_size ? table[k] : local_map_->outside;
-      local_map_->near(row, col) = d <= 2.0 * sigma_cells ? 1.0f : 0.0f;
     }
 }
 
@@ -209,7 +207,7 @@ common::Pose2 ScanMatchedOdometry::correct(const common::Pose2& odometry,
               score += map.outside;
             } else {
               score += map.log_likelihood(row, col);
-              near += map.near(row, col) > 0.5f;
+              near += map.near(row, col) != 0;
             }
           }
           // The prediction's Gaussian prior.
@@ -233,9 +231,6 @@ common::Pose2 ScanMatchedOdometry::correct(const common::Pose2& odometry,
           }
       corrected = {predicted.x + mx / weight_sum, predicted.y + my / weight_sum,
                    common::wrapAngle(predicted.yaw + mphi / weight_sum)};
-      ++used_;
-    } else {
-      ++rejected_;
     }
   }
   last_corrected_ = corrected;

@@ -20,7 +20,7 @@ struct Axes {
 
 // A door line along x is a row of cells; along y, a column.
 const Axes kAxes[2] = {{common::DoorOrientation::kAlongX, {1, 0}, {0, 1}},
-                           {common::DoorOrientation::kAlongY, {0, 1}, {1, 0}}};
+                       {common::DoorOrientation::kAlongY, {0, 1}, {1, 0}}};
 
 bool inside(const OccupancyGrid& map, const cv::Point& cell) {
   return cell.x >= 0 && cell.y >= 0 && cell.x < map.width() && cell.y < map.height();

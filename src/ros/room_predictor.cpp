@@ -204,11 +204,7 @@ bool RoomPredictorNode::saveDoors(SaveDoors::Request& request, SaveDoors::Respon
     if (!default_doors_ || default_doors_->doors.empty())
       throw common::InputError("save_doors", "the node has no doors (no ~closed_doors_file, no door clicked)");
     if (request.path.empty()) throw common::InputError("save_doors", "the request names no file");
-    const std::filesystem::path folder = std::filesystem::path(request.path).parent_path();
-    std::error_code error;
-    if (!folder.empty()) std::filesystem::create_directories(folder, error);
-    if (error) throw common::InputError(request.path, "its folder cannot be created: " + error.message());
-    common::saveDoors(*default_doors_, request.path);
+    common::saveDoors(*default_doors_, request.path);  // writes atomically, creating the file's folder
     response.success = true;
     response.message = "wrote " + std::to_string(default_doors_->doors.size()) + " doors to " + request.path;
   } catch (const std::exception& error) {

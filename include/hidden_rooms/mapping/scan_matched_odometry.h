@@ -51,9 +51,6 @@ class ScanMatchedOdometry {
   // The corrected pose for this odometry pose and scan (the first one: the odometry pose itself).
   common::Pose2 correct(const common::Pose2& odometry, const mrpt::obs::CObservation2DRangeScan& scan);
 
-  int matchesUsed() const { return used_; }
-  int matchesRejected() const { return rejected_; }
-
  private:
   struct Keyframe;
   struct LocalMap;
@@ -64,7 +61,6 @@ class ScanMatchedOdometry {
   common::Pose2 last_odometry_, last_corrected_, last_keyframe_;
   std::deque<std::shared_ptr<Keyframe>> keyframes_;
   std::unique_ptr<LocalMap> local_map_;
-  int used_ = 0, rejected_ = 0;
 };
 
 }  // namespace hidden_rooms::mapping
