@@ -84,6 +84,18 @@ class MapperTest : public ::testing::Test {
   nav_msgs::MapMetaData::ConstPtr metadata_;
 };
 
+// `actual` (a map from a service) is the same map as `expected` (the published one): same resolution, origin and
+// size, and at most 1 % of the cells differ (the filter may have inserted a scan in between).
+void expectSameMap(const common::OccupancyGrid& actual, const common::OccupancyGrid& expected, const char* what) {
+  EXPECT_DOUBLE_EQ(actual.resolution, expected.resolution) << what;
+  EXPECT_NEAR(actual.origin.x(), expected.origin.x(), 1e-3) << what;
+  EXPECT_NEAR(actual.origin.y(), expected.origin.y(), 1e-3) << what;
+  ASSERT_EQ(actual.cells.size(), expected.cells.size()) << what;
+  const int differing = cv::countNonZero(actual.cells != expected.cells);
+  EXPECT_LE(differing, expected.cells.total() / 100) << what << ": " << differing << " of " << expected.cells.total()
+                                                     << " cells differ from the published map";
+}
+
 TEST_F(MapperTest, MapsTheWorldPublishesTfAndSavesTheMap) {
   ASSERT_TRUE(waitFor([this] { return !truth_.empty() && !scans_.empty(); }, 30.0)) << "no simulator messages";
   const double start = truthTime();
@@ -93,11 +105,13 @@ TEST_F(MapperTest, MapsTheWorldPublishesTfAndSavesTheMap) {
   const double stop = truthTime();
   ASSERT_TRUE(waitFor([&] { return truthTime() >= stop + 2.0; }, 20.0));
 
-  // The latched map: frame, stamp, values, metadata. One stamped after the stop, so that it and the final
-  // map -> odom come from the same filter state (a busy mapper still works through older scans).
-  ASSERT_TRUE(waitFor([&] { return map_ != nullptr && metadata_ != nullptr && map_->header.stamp.toSec() >= stop; },
-                      20.0))
-      << "no map / map_metadata stamped after the robot stopped";
+  // The latched map: frame, stamp, values, metadata. One stamped after the robot came to rest, so that it, the
+  // final map -> odom and the maps of save_map and dynamic_map come from the same filter state (a busy mapper
+  // still works through older scans, and the best particle, whose map is published, may change while moving).
+  const double rest = stop + 2.0;
+  ASSERT_TRUE(waitFor([&] { return map_ != nullptr && metadata_ != nullptr && map_->header.stamp.toSec() >= rest; },
+                      30.0))
+      << "no map / map_metadata stamped after the robot came to rest";
   EXPECT_EQ(map_->header.frame_id, "map");
   EXPECT_FALSE(map_->header.stamp.isZero());
   EXPECT_FLOAT_EQ(map_->info.resolution, 0.05f);
@@ -132,8 +146,8 @@ TEST_F(MapperTest, MapsTheWorldPublishesTfAndSavesTheMap) {
   const evaluation::MapQuality quality = evaluation::evaluateMap(fromRos(*map_), world_from_map, truth.map, observed);
   std::printf("scans %zu, free IoU %.3f (true %lld, map %lld), walls within 2 cells %.3f\n", scans_.size(),
               quality.free_iou, quality.true_free_cells, quality.map_free_cells, quality.walls_within_2_cells);
-  EXPECT_GE(quality.free_iou, 0.85);  // measured 0.95
-  EXPECT_GE(quality.walls_within_2_cells, 0.90);  // measured 0.998
+  EXPECT_GE(quality.free_iou, 0.85);  // measured 0.95; 0.90 to 0.97 with three busy processes beside
+  EXPECT_GE(quality.walls_within_2_cells, 0.85);  // measured 0.998; 0.91 to 1.00 with three busy processes beside
 
   // save_map: map_server files of the same map.
   const std::string prefix = testing::makeTempDir("mapper_test") + "/saved";
@@ -146,10 +160,7 @@ TEST_F(MapperTest, MapsTheWorldPublishesTfAndSavesTheMap) {
   const common::OccupancyGrid published = fromRos(*map_);
   const common::OccupancyGrid saved = common::loadMap(prefix + ".yaml");
   EXPECT_DOUBLE_EQ(saved.resolution, 0.05);
-  EXPECT_GE(saved.width(), published.width());  // the map may have grown since the last publication
-  EXPECT_GE(saved.height(), published.height());
-  EXPECT_GT(cv::countNonZero(saved.cells == 0), 1000);
-  EXPECT_GT(cv::countNonZero(saved.cells == 100), 100);
+  expectSameMap(saved, common::trinary(published), "save_map");
 
   save.request.prefix = prefix + ".yaml/x";  // a file where a folder must be
   ASSERT_TRUE(ros::service::call("save_map", save));
@@ -160,9 +171,8 @@ TEST_F(MapperTest, MapsTheWorldPublishesTfAndSavesTheMap) {
   nav_msgs::GetMap dynamic;
   ASSERT_TRUE(ros::service::call("dynamic_map", dynamic));
   EXPECT_EQ(dynamic.response.map.header.frame_id, "map");
-  EXPECT_GE(dynamic.response.map.info.width, published.width());
-  EXPECT_GE(dynamic.response.map.info.height, published.height());
   EXPECT_FLOAT_EQ(dynamic.response.map.info.resolution, 0.05f);
+  expectSameMap(fromRos(dynamic.response.map), published, "dynamic_map");
 }
 
 }  // namespace
