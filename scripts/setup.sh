@@ -11,43 +11,53 @@ export PATH="/usr/bin:$PATH"
 WS="$ROOT/.ws"
 BUILD_TYPE="${HIDDEN_ROOMS_BUILD_TYPE:-Release}"
 
-PACKAGES=(
-  build-essential cmake git
-  # ROS 1 (Debian's own packages)
-  catkin python3-catkin python3-catkin-pkg python3-rospkg ros-core-dev rosbash
-  python3-rospy python3-roslaunch python3-rostest python3-rosbag python3-rosservice python3-rostopic
-  python3-rosnode python3-rosmsg python3-roslib
-  libtf2-dev libtf2-ros-dev python3-tf2-ros tf2-tools
-  libnav-msgs-dev python3-nav-msgs libsensor-msgs-dev python3-sensor-msgs libgeometry-msgs-dev
-  python3-geometry-msgs libvisualization-msgs-dev python3-visualization-msgs libstd-srvs-dev python3-std-srvs
-  libros-rosgraph-msgs-dev python3-rosgraph-msgs
-  ros-message-generation ros-message-runtime librosbag-dev librostest-dev rviz librviz-dev libtf2-msgs-dev libroslib-dev
-  # algorithms and files
-  libmrpt-slam-dev libmrpt-maps-dev libmrpt-nav-dev libmrpt-ros1bridge-dev libbox2d-dev liboctomap-dev
-  libopencv-dev libeigen3-dev libpng-dev libtinyxml2-dev libyaml-cpp-dev libboost-program-options-dev
-  # tests and scripts
-  libgtest-dev googletest python3-nose python3-yaml python3-numpy python3-matplotlib python3-tqdm
-  python3-opencv xvfb time
-  # batch analysis: the Python module's install (setuptools) and the Dask cluster option
-  python3-setuptools python3-distributed
-  # fuzzing (scripts/fuzz.sh): clang with libFuzzer
-  clang libclang-rt-14-dev
-)
+# Tools, not dependencies of the package: the toolchain, rosdep (which reads package.xml) and the fuzzer's runtime
+# (scripts/fuzz.sh; clang itself is a test_depend).
+TOOLS=(build-essential cmake git python3-rosdep2 libclang-rt-14-dev)
 
-missing=()
-while read -r package status; do
-  [ "$status" = "installed" ] || missing+=("$package")
-done < <(for p in "${PACKAGES[@]}"; do
-  printf '%s %s\n' "$p" "$(dpkg-query -W -f='${db:Status-Status}' "$p" 2>/dev/null || echo missing)"
-done)
-
-if [ "${#missing[@]}" -gt 0 ]; then
+apt_updated=0
+# Installs those of the given Debian packages that are not installed yet.
+install_missing() {
+  local missing=() package
+  for package in "$@"; do
+    [ "$(dpkg-query -W -f='${db:Status-Status}' "$package" 2>/dev/null)" = "installed" ] || missing+=("$package")
+  done
+  [ "${#missing[@]}" -gt 0 ] || return 0
   echo "setup: installing ${#missing[@]} Debian packages: ${missing[*]}"
-  SUDO=""
-  [ "$(id -u)" -eq 0 ] || SUDO="sudo"
-  $SUDO apt-get update -q
-  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -q --no-install-recommends "${missing[@]}"
-fi
+  local sudo=""
+  [ "$(id -u)" -eq 0 ] || sudo="sudo"
+  if [ "$apt_updated" -eq 0 ]; then
+    $sudo apt-get update -q
+    apt_updated=1
+  fi
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -q --no-install-recommends "${missing[@]}"
+}
+
+install_missing "${TOOLS[@]}"
+
+# The dependencies: every rosdep key of package.xml, resolved by rosdep without the network from Debian's list of
+# ROS packages and the package's rosdep.yaml (the system keys, as rosdistro resolves them on Debian 12).
+ROSDEP_HOME="$WS/rosdep"
+mkdir -p "$ROSDEP_HOME/sources.list.d"
+printf 'yaml file:///usr/share/python3-rosdep2/debian.yaml debian\nyaml file://%s/rosdep.yaml\n' "$ROOT" \
+  >"$ROSDEP_HOME/sources.list.d/20-hidden-rooms.list"
+printf '%%YAML 1.1\n---\ntype: index\nversion: 4\ndistributions: {}\n' >"$ROSDEP_HOME/index.yaml"
+rosdep_offline() {
+  ROSDEP_SOURCE_PATH="$ROSDEP_HOME/sources.list.d" ROS_HOME="$ROSDEP_HOME" \
+    ROSDISTRO_INDEX_URL="file://$ROSDEP_HOME/index.yaml" rosdep "$@"
+}
+rosdep_offline update -q >/dev/null 2>&1 || rosdep_offline update  # again, to show why it failed
+keys="$(/usr/bin/python3 -c '
+import sys
+from catkin_pkg.package import parse_package
+package = parse_package(sys.argv[1])
+dependencies = (package.buildtool_depends + package.build_depends + package.build_export_depends +
+                package.exec_depends + package.test_depends)
+print(" ".join(sorted({dependency.name for dependency in dependencies})))' "$ROOT")"
+# shellcheck disable=SC2086  # one word per key
+resolved="$(rosdep_offline resolve $keys)"  # "#apt" lines, then each key's packages
+read -r -a PACKAGES <<<"$(grep -v '^#' <<<"$resolved" | tr '\n' ' ')"
+install_missing "${PACKAGES[@]}"
 
 # The workspace's src/hidden_rooms mirrors the checkout with one link per top-level entry (a single link to
 # the checkout would put the workspace inside itself, and rosrun's search would loop).

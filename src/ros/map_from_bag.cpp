@@ -28,7 +28,7 @@
 #include "hidden_rooms/evaluation/map_quality.h"
 #include "hidden_rooms/mapping/rbpf_mapper.h"
 #include "hidden_rooms/ros/conversions.h"
-#include "hidden_rooms/ros/mrpt_scan.h"
+#include "ros/mrpt_scan.h"
 #include "hidden_rooms/world/environment.h"
 #include "hidden_rooms/world/render.h"
 

@@ -1,4 +1,4 @@
-#include "hidden_rooms/ros/mrpt_scan.h"
+#include "ros/mrpt_scan.h"
 
 #include <algorithm>
 #include <cmath>

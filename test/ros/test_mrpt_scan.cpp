@@ -7,7 +7,7 @@
 
 #include "hidden_rooms/common/input_error.h"
 #include "hidden_rooms/ros/conversions.h"
-#include "hidden_rooms/ros/mrpt_scan.h"
+#include "ros/mrpt_scan.h"
 
 namespace hidden_rooms {
 namespace {

@@ -51,7 +51,7 @@ class RbpfMapper {
   // last update. Returns true when the scan was inserted into the map. Throws InputError for a scan without
   // beams or with a non-finite geometry.
   bool addScan(const common::Pose2& odometry, const common::RangeScan& scan);
-  // The same with a scan already in MRPT's form (ROS messages: hidden_rooms/ros/mrpt_scan.h, mrpt-ros1bridge);
+  // The same with a scan already in MRPT's form (ROS messages: src/ros/mrpt_scan.h, mrpt-ros1bridge);
   // its sensorPose is the laser in base_link. Throws InputError for a scan without beams.
   bool addScan(const common::Pose2& odometry, const mrpt::obs::CObservation2DRangeScan& scan);
 

@@ -1,7 +1,8 @@
 #pragma once
 
 // The scan conversion of the mapper node and map_from_bag: sensor_msgs/LaserScan -> MRPT through mrpt-ros1bridge.
-// Only these two link MRPT (library hidden_rooms_slam_ros), so the other nodes keep their short start-up.
+// Only these two link MRPT (library hidden_rooms_mapping_ros), so the other nodes keep their short start-up. A
+// private header: packages that build against this one do not get MRPT's include folders.
 
 #include <mrpt/obs/CObservation2DRangeScan.h>
 #include <sensor_msgs/LaserScan.h>
