@@ -8,6 +8,11 @@ maps in a row each grew by less than --growth over the one before, or at --max-t
 closed doors translated into the map frame (translate_doors, docs/method.md#closed-doors-in-the-map), the run's scores
 against its world and, with --method, the predicted rooms and their IoU are written. DIR/summary.csv has one row per world.
 
+Progress: while a world runs, its worker writes DIR/WORLD/progress.json (phase, simulated time, mapped free area,
+goals so far, saved maps) about once a second; the main process shows it as one tqdm bar per running world on
+stderr (total: --max-time simulated seconds), when stderr is a terminal and --no-progress is not given. The goals
+are counted from the explorer's exploration_markers (each new goal position), which the worker subscribes to.
+
 A re-run keeps the worlds already finished with the same settings (DIR/WORLD/result.json, written atomically)
 and runs the others again. Every child process gets SIGTERM when its parent dies, so a run killed even by SIGKILL
 leaves no master, simulator or mapper behind.
@@ -22,6 +27,7 @@ import ctypes
 import glob
 import json
 import os
+import queue
 import random
 import signal
 import socket
@@ -37,12 +43,14 @@ from hidden_rooms.package_tools import ArgumentParser, ToolError, find_binary, t
 
 SUMMARY_NAME = "summary.csv"
 RESULT_NAME = "result.json"
+PROGRESS_NAME = "progress.json"
 SUMMARY_COLUMNS = ["world", "status", "closed_doors", "sim_time_s", "wall_time_s", "path_length_m", "coverage",
                    "coverage_all_free", "free_iou", "worst_door_error_m", "mean_iou", "message"]
 MASTER_START_TIMEOUT = 60.0   # wall seconds for roslaunch's master and the simulator's clock
 PR_SET_PDEATHSIG = 1          # prctl option (linux/prctl.h)
 STALL_TIMEOUT = 60.0          # wall seconds without simulated time advancing: the run is stuck
 SHUTDOWN_TIMEOUT = 20.0       # wall seconds for roslaunch to stop after SIGINT
+PROGRESS_INTERVAL = 1.0       # wall seconds between two writes of progress.json (worker) and two bar updates
 
 
 def die_with_parent():
@@ -99,6 +107,98 @@ def closed_doors_of(spec, world, seed):
 
 
 # --------------------------------------------------------------------------------------------------------
+# Progress (progress.json of a running world, shown as a bar)
+
+
+def write_progress(out_dir, phase, sim_time=0.0, free_area=None, goals=None, maps_saved=0, stop=None):
+    """out_dir/progress.json: the phase ('starting', 'exploring', 'finishing'), simulated seconds, mapped free area
+    (m²), goals so far, saved maps and, once finishing, the stop reason. Best effort: a failed write is skipped."""
+    try:
+        write_json_atomically(os.path.join(out_dir, PROGRESS_NAME), {
+            "phase": phase, "sim_time": round(sim_time, 1),
+            "free_area_m2": None if free_area is None else round(free_area, 2), "goals": goals,
+            "maps_saved": maps_saved, "stop": stop})
+    except OSError:
+        pass
+
+
+def read_progress(out_dir):
+    """The progress.json of a running world, or None (not written yet, or unreadable)."""
+    try:
+        with open(os.path.join(out_dir, PROGRESS_NAME)) as progress_file:
+            return json.load(progress_file)
+    except (OSError, ValueError):
+        return None
+
+
+def status_text(progress, floor_area=None):
+    """The bar's status of a world from its progress (read_progress): the phase unless exploring, the mapped free
+    area (and its share of `floor_area`, m², when known: closed rooms count in it, so a finished run stays below
+    100 %), the goals and the saved maps."""
+    if not progress or progress.get("phase") == "starting":
+        return "starting ROS"
+    parts = []
+    if progress.get("phase") != "exploring":
+        stop = progress.get("stop")
+        parts.append("%s (%s)" % (progress["phase"], stop) if stop else progress["phase"])
+    free = progress.get("free_area_m2")
+    if free is not None:
+        mapped = "mapped %.0f m²" % free
+        if floor_area:
+            mapped += " (%.0f %% of the floor)" % (100.0 * free / floor_area)
+        parts.append(mapped)
+    goals = progress.get("goals")
+    if goals is not None:
+        parts.append("%d goal%s" % (goals, "" if goals == 1 else "s"))
+    maps = progress.get("maps_saved") or 0
+    parts.append("%d map%s saved" % (maps, "" if maps == 1 else "s"))
+    return ", ".join(parts)
+
+
+def floor_area_of(world):
+    """The world's floor area in m² (`batch_cases --info`: the sum of its spaces, closed rooms included), or None."""
+    try:
+        binary = find_binary(batch_analysis.TOOL_NAME)
+        result = subprocess.run([binary, world, "--info"], capture_output=True, text=True,
+                                stdin=subprocess.DEVNULL, timeout=60)
+        if result.returncode != 0:
+            return None
+        return float(json.loads(result.stdout.strip().splitlines()[-1])["floor_area"])
+    except (ToolError, OSError, ValueError, KeyError, IndexError, TypeError, subprocess.TimeoutExpired):
+        return None
+
+
+class WorldProgress:
+    """One world's tqdm bar on stderr (disabled by --no-progress or when stderr is not a terminal): simulated seconds
+    of --max-time, with status_text as postfix. `slots` hands out the bars' lines among the worlds running."""
+
+    def __init__(self, args, world, slots):
+        from tqdm import tqdm
+        self.slots = slots
+        self.slot = slots.get()
+        self.bar = tqdm(total=int(args.max_time), desc=world_name(world), position=self.slot, leave=False,
+                        file=sys.stderr, disable=True if args.no_progress else None, dynamic_ncols=True,
+                        bar_format="{desc}: {percentage:3.0f}%|{bar}| {n}/{total} s simulated "
+                                   "[{elapsed}<{remaining}{postfix}]")
+        self.floor_area = None if self.bar.disable else floor_area_of(world)
+        self.show(None)
+
+    def show(self, progress):
+        if self.bar.disable:
+            return
+        sim_time = min(int((progress or {}).get("sim_time") or 0), self.bar.total)
+        self.bar.set_postfix_str(status_text(progress, self.floor_area), refresh=False)
+        if sim_time > self.bar.n:
+            self.bar.update(sim_time - self.bar.n)
+        else:
+            self.bar.refresh()
+
+    def close(self):
+        self.bar.close()
+        self.slots.put(self.slot)
+
+
+# --------------------------------------------------------------------------------------------------------
 # One world (worker process, with its own ROS master)
 
 
@@ -109,12 +209,18 @@ class Run:
         import rospy
         from nav_msgs.msg import OccupancyGrid
         from std_msgs.msg import Bool
+        from visualization_msgs.msg import MarkerArray
         self.rospy = rospy
         rospy.init_node("explore_worlds_" + name.replace("-", "_"), anonymous=True, disable_signals=True)
         self.done = False
         self.free_cells = 0
+        self.free_area = None
+        self.goals = 0
+        self.last_goal = None
         rospy.Subscriber("exploration_done", Bool, self._on_done, queue_size=1)
         rospy.Subscriber("map", OccupancyGrid, self._on_map, queue_size=1)
+        # The explorer publishes its markers after each plan while subscribed; a new goal position is a new goal.
+        rospy.Subscriber("exploration_markers", MarkerArray, self._on_markers, queue_size=20)
 
     def _on_done(self, message):
         self.done = self.done or message.data
@@ -122,6 +228,15 @@ class Run:
     def _on_map(self, message):
         cells = np.asarray(message.data, dtype=np.int8)
         self.free_cells = int(np.count_nonzero((cells >= 0) & (cells <= 19)))
+        self.free_area = self.free_cells * message.info.resolution ** 2
+
+    def _on_markers(self, message):
+        for marker in message.markers:
+            if marker.ns == "goal" and marker.action == marker.ADD:
+                position = (round(marker.pose.position.x, 2), round(marker.pose.position.y, 2))
+                if position != self.last_goal:
+                    self.last_goal = position
+                    self.goals += 1
 
     def sim_time(self):
         return self.rospy.get_time()
@@ -196,12 +311,16 @@ def explore(args, out_dir, log):
         growth_stop = GrowthStop(args.growth, args.patience)
         next_save = args.timeout
         last_sim, last_progress = 0.0, time.monotonic()
+        last_written = 0.0
         while status is None:
             time.sleep(0.2)
             if launch.poll() is not None:
                 raise RuntimeError("roslaunch exited with code %d during the run (see %s)"
                                    % (launch.returncode, log.name))
             now = run.sim_time()
+            if time.monotonic() - last_written >= PROGRESS_INTERVAL:
+                write_progress(out_dir, "exploring", now, run.free_area, run.goals, saved)
+                last_written = time.monotonic()
             if now > last_sim:
                 last_sim, last_progress = now, time.monotonic()
             elif time.monotonic() - last_progress > STALL_TIMEOUT:
@@ -216,6 +335,7 @@ def explore(args, out_dir, log):
                 if growth_stop.update(free):
                     status = "no_growth"
                 next_save += args.timeout
+        write_progress(out_dir, "finishing", run.sim_time(), run.free_area, run.goals, saved, status)
         run.save_map(os.path.join(out_dir, "map"))
         return status, run.sim_time()
     finally:
@@ -299,6 +419,7 @@ def run_worker(args):
               "path_length_m": "", "coverage": "", "coverage_all_free": "", "free_iou": "", "worst_door_error_m": "", "mean_iou": "",
               "message": ""}
     started = time.monotonic()
+    write_progress(out_dir, "starting")
     with open(os.path.join(out_dir, "launch.log"), "w") as log:
         try:
             status, sim_time = explore(args, out_dir, log)
@@ -343,6 +464,9 @@ def parse_arguments(argv):
     parser.add_argument("--method", default="default", help="prediction method on the explored map ('' = none)")
     parser.add_argument("--bag", action="store_true", help="also record a bag per world (run.bag)")
     parser.add_argument("--gui", action="store_true", help="show rviz (needs a display; use with --jobs 1)")
+    parser.add_argument("--no-progress", action="store_true",
+                        help="no progress bars (by default one per running world on stderr when it is a terminal: "
+                             "simulated time, mapped area, goals, saved maps)")
     parser.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     for name in ("timeout", "max_time", "realtime_factor"):
@@ -384,8 +508,9 @@ def finished_result(out_dir, settings):
     return result if result.get("status") != "failed" and result.get("settings") == settings else None
 
 
-def explore_one(args, world):
-    """Runs a worker for `world` with its own master; returns its result dictionary."""
+def explore_one(args, world, slots):
+    """Runs a worker for `world` with its own master, showing its progress (WorldProgress on one of `slots`);
+    returns its result dictionary."""
     env = dict(os.environ, ROS_MASTER_URI="http://127.0.0.1:%d" % free_port(),
                ROS_LOG_DIR=os.path.join(args.out, world_name(world), "ros_log"))
     out_dir = os.path.join(args.out, world_name(world))
@@ -398,9 +523,28 @@ def explore_one(args, world):
     if kept is not None:
         kept["message"] = "kept from an earlier run"
         return kept
-    with open(os.path.join(out_dir, "worker.log"), "w") as log:
-        subprocess.run(worker_command(args, world, closed), env=env, stdout=log, stderr=subprocess.STDOUT,
-                       preexec_fn=die_with_parent)
+    progress_path = os.path.join(out_dir, PROGRESS_NAME)
+    if os.path.exists(progress_path):  # an earlier, killed run's
+        os.remove(progress_path)
+    progress = WorldProgress(args, world, slots)
+    try:
+        with open(os.path.join(out_dir, "worker.log"), "w") as log:
+            worker = subprocess.Popen(worker_command(args, world, closed), env=env, stdout=log,
+                                      stderr=subprocess.STDOUT, preexec_fn=die_with_parent)
+            try:
+                while worker.poll() is None:
+                    try:
+                        worker.wait(timeout=PROGRESS_INTERVAL)
+                    except subprocess.TimeoutExpired:
+                        progress.show(read_progress(out_dir))
+            except BaseException:
+                worker.kill()
+                worker.wait()
+                raise
+    finally:
+        progress.close()
+        if os.path.exists(progress_path):
+            os.remove(progress_path)
     try:
         with open(os.path.join(out_dir, RESULT_NAME)) as result_file:
             return json.load(result_file)
@@ -422,16 +566,21 @@ def main(argv=None):
     except ToolError as error:
         print("explore_worlds: error: %s" % error, file=sys.stderr)
         return 2
+    from tqdm import tqdm
     results = []
+    slots = queue.Queue()  # the progress bars' lines, one per world running
+    for slot in range(args.jobs):
+        slots.put(slot)
     with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
-        futures = {pool.submit(explore_one, args, world): world for world in worlds}
+        futures = {pool.submit(explore_one, args, world, slots): world for world in worlds}
         for future in concurrent.futures.as_completed(futures):
             result = future.result()
             results.append(result)
-            print("explore_worlds: %s: %s, %s s simulated in %s s, coverage %s, mean IoU %s %s"
-                  % (world_name(result["world"]), result["status"], result.get("sim_time_s", ""),
-                     result.get("wall_time_s", ""), result.get("coverage", ""), result.get("mean_iou", ""),
-                     result.get("message", "")), flush=True)
+            tqdm.write("explore_worlds: %s: %s, %s s simulated in %s s, coverage %s, mean IoU %s %s"
+                       % (world_name(result["world"]), result["status"], result.get("sim_time_s", ""),
+                          result.get("wall_time_s", ""), result.get("coverage", ""), result.get("mean_iou", ""),
+                          result.get("message", "")), file=sys.stdout)
+            sys.stdout.flush()
     order = {world: k for k, world in enumerate(worlds)}
     results.sort(key=lambda result: order.get(result["world"], len(order)))
     summary = os.path.join(args.out, SUMMARY_NAME)

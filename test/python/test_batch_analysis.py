@@ -3,10 +3,12 @@
 a Dask LocalCluster giving the rows of the local run, the plots, and bad input.
 
 Needs the built batch_cases (found like the scripts find it: $CMAKE_PREFIX_PATH, else the checkout's .ws); the
-tests skip without it, unless HIDDEN_ROOMS_REQUIRE_SHARED=1, when they fail. The shared data folder
+tests skip without it, unless HIDDEN_ROOMS_REQUIRE_SHARED=1, when they fail; PlotBatchTest needs no tool (its
+results.csv is written by hand: formats, confidence intervals, the LaTeX table). The shared data folder
 ($HIDDEN_ROOMS_SHARED_DIR or ../shared beside the checkout) is used by one test, which skips when it is absent.
 """
 import csv
+import math
 import os
 import shutil
 import signal
@@ -15,6 +17,7 @@ import sys
 import tempfile
 import time
 import unittest
+from xml.etree import ElementTree
 
 PACKAGE_DIR = os.path.dirname(os.path.dirname(os.path.dirname(os.path.realpath(__file__))))
 sys.path.insert(0, os.path.join(PACKAGE_DIR, "src"))
@@ -26,6 +29,10 @@ SMALL_WORLD = os.path.join(PACKAGE_DIR, "worlds", "small_1.xml")
 MEDIUM_WORLD = os.path.join(PACKAGE_DIR, "worlds", "medium_1.xml")
 METHODS = "default,thesis,unstructured,structured,skewnormal"
 TIMING_COLUMNS = {"case_seconds"} | {"seconds_%s" % method for method in METHODS.split(",")}
+
+
+PLOT_FORMATS = ["png", "pdf", "svg"]
+PLOT_STEMS = ["iou_vs_closed_doors", "iou_tot_vs_closed_doors", "iou_by_size_class", "table"]
 
 
 def required():
@@ -52,6 +59,24 @@ def script_environment():
 def run_batch(*arguments, timeout=600):
     return subprocess.run([sys.executable, BATCH_SCRIPT, "--no-progress"] + list(arguments), capture_output=True,
                           text=True, timeout=timeout, env=script_environment())
+
+
+def run_plot(*arguments):
+    return subprocess.run([sys.executable, PLOT_SCRIPT] + list(arguments), capture_output=True, text=True,
+                          timeout=300, env=script_environment())
+
+
+def check_figures(test, out_dir, formats):
+    """Every figure of plot_batch in every format: non-empty, a PDF starting with %PDF, an SVG that parses."""
+    for stem in PLOT_STEMS:
+        for extension in formats:
+            path = os.path.join(out_dir, "%s.%s" % (stem, extension))
+            test.assertTrue(os.path.isfile(path) and os.path.getsize(path) > 0, path)
+            if extension == "pdf":
+                with open(path, "rb") as stream:
+                    test.assertEqual(stream.read(4), b"%PDF", path)
+            elif extension == "svg":
+                test.assertTrue(ElementTree.parse(path).getroot().tag.endswith("svg"), path)
 
 
 def read_rows(out_dir):
@@ -188,11 +213,10 @@ class BatchAnalysisTest(unittest.TestCase):
         small = run_batch("--env", SMALL_WORLD, "--batches", "1", "--max-closed", "2", "--methods", METHODS,
                           "--out", tiny_dir, "--binary", self.binary)
         self.assertEqual(small.returncode, 0, small.stderr)
-        result = subprocess.run([sys.executable, PLOT_SCRIPT, self.reference_dir, tiny_dir, "--out", out_dir],
-                                capture_output=True, text=True, timeout=300, env=script_environment())
+        result = run_plot(self.reference_dir, tiny_dir, "--out", out_dir)
         self.assertEqual(result.returncode, 0, result.stdout + result.stderr)
-        for name in ["iou_vs_closed_doors.png", "iou_tot_vs_closed_doors.png", "table.png", "table.csv",
-                     "table.md"]:
+        check_figures(self, out_dir, PLOT_FORMATS)
+        for name in ["table.csv", "table.md", "table.tex"]:
             path = os.path.join(out_dir, name)
             self.assertTrue(os.path.isfile(path) and os.path.getsize(path) > 0, name)
         with open(os.path.join(out_dir, "table.csv"), newline="") as stream:
@@ -202,6 +226,12 @@ class BatchAnalysisTest(unittest.TestCase):
         medium = [row for row in table if row["size_class"] == "medium" and row["closed_doors"] != "all"]
         self.assertEqual([int(row["closed_doors"]) for row in medium], list(range(1, 13)))
         self.assertTrue(all(int(row["cases"]) == 3 for row in medium))
+        for row in medium:  # 3 batches: an interval around the mean
+            low, mean, high = (float(row[name]) for name in ("ci_low_default", "iou_default", "ci_high_default"))
+            self.assertLessEqual(low, mean)
+            self.assertLessEqual(mean, high)
+        small = [row for row in table if row["size_class"] == "small"]
+        self.assertTrue(small and all(row["batches"] == "1" and row["ci_low_default"] == "" for row in small))
         with open(os.path.join(out_dir, "table.md")) as stream:
             self.assertIn("| closed | cases | % hidden | IoU default", stream.read())
         bad = subprocess.run([sys.executable, PLOT_SCRIPT, os.path.join(self.folder, "nothing_here")],
@@ -252,6 +282,113 @@ class BatchAnalysisTest(unittest.TestCase):
         self.assertFalse(os.path.exists(stale))
         self.assertTrue(os.path.isdir(mine))
         os.rmdir(mine)
+
+
+class PlotBatchTest(unittest.TestCase):
+    """plot_batch on a results.csv written by hand (no batch_cases needed): small has 3 batches, medium 1."""
+
+    METHODS = ["default", "my_method"]
+    # Per small batch, default's IoU in every case: batch means 0.4, 0.5, 0.6.
+    SMALL_DEFAULT = {1: 0.4, 2: 0.5, 3: 0.6}
+
+    @classmethod
+    def setUpClass(cls):
+        cls.folder = tempfile.mkdtemp(prefix="plot_batch_test_")
+        cls.results_dir = os.path.join(cls.folder, "batch")
+        os.makedirs(cls.results_dir)
+        columns = batch_analysis.result_columns(cls.METHODS)
+        with open(os.path.join(cls.results_dir, "results.csv"), "w", newline="") as stream:
+            writer = csv.DictWriter(stream, fieldnames=columns, lineterminator="\n")
+            writer.writeheader()
+            for environment, size_class, batches in [("s1", "small", (1, 2, 3)), ("m1", "medium", (1,))]:
+                for batch in batches:
+                    for closed in (1, 2, 3):
+                        row = {name: "0" for name in columns}
+                        row.update(environment=environment, size_class=size_class, batch=str(batch),
+                                   closed_doors=str(closed), hidden_percent=str(4.0 * closed),
+                                   closed_door_ids=" ".join(map(str, range(1, closed + 1))), failed_methods="")
+                        default = cls.SMALL_DEFAULT[batch] if size_class == "small" else 0.7
+                        row.update(iou_default=str(default), iou_tot_default=str(default + 0.1),
+                                   iou_my_method=str(0.3 + 0.05 * closed + 0.02 * batch),
+                                   iou_tot_my_method=str(0.35 + 0.05 * closed))
+                        writer.writerow(row)
+        cls.out_dir = os.path.join(cls.folder, "plots")
+        cls.result = run_plot(cls.results_dir, "--out", cls.out_dir)
+
+    @classmethod
+    def tearDownClass(cls):
+        shutil.rmtree(cls.folder, ignore_errors=True)
+
+    def read_table(self):
+        with open(os.path.join(self.out_dir, "table.csv"), newline="") as stream:
+            return list(csv.DictReader(stream))
+
+    def test_every_format_is_written(self):
+        self.assertEqual(self.result.returncode, 0, self.result.stdout + self.result.stderr)
+        check_figures(self, self.out_dir, PLOT_FORMATS)
+        only_pdf = os.path.join(self.folder, "only_pdf")
+        result = run_plot(self.results_dir, "--out", only_pdf, "--formats", "pdf")
+        self.assertEqual(result.returncode, 0, result.stdout + result.stderr)
+        check_figures(self, only_pdf, ["pdf"])
+        self.assertFalse([name for name in os.listdir(only_pdf) if name.endswith((".png", ".svg"))])
+
+    def test_confidence_intervals_over_batches(self):
+        self.assertEqual(self.result.returncode, 0, self.result.stdout + self.result.stderr)
+        table = self.read_table()
+        for name in ("ci_low_default", "ci_high_default", "ci_low_tot_my_method", "ci_high_tot_my_method",
+                     "batches"):
+            self.assertIn(name, table[0])
+        small = [row for row in table if row["size_class"] == "small"]
+        medium = [row for row in table if row["size_class"] == "medium"]
+        self.assertEqual([row["closed_doors"] for row in small], ["1", "2", "3", "all"])
+        for row in small:
+            self.assertEqual(row["batches"], "3")
+            for method in self.METHODS:
+                low, mean, high = (float(row[name + method]) for name in ("ci_low_", "iou_", "ci_high_"))
+                self.assertTrue(all(map(math.isfinite, (low, mean, high))), row)
+                self.assertTrue(low <= mean <= high, row)
+            # Batch means 0.4, 0.5, 0.6: 0.5 +- t(0.975, 2 df) * 0.1 / sqrt(3).
+            self.assertAlmostEqual(float(row["ci_low_default"]), 0.5 - 4.303 * 0.1 / math.sqrt(3), places=3)
+            self.assertAlmostEqual(float(row["ci_high_default"]), 0.5 + 4.303 * 0.1 / math.sqrt(3), places=3)
+        for row in medium:  # one batch: no interval
+            self.assertEqual(row["batches"], "1")
+            for method in self.METHODS:
+                self.assertEqual((row["ci_low_" + method], row["ci_high_" + method]), ("", ""), row)
+        with open(os.path.join(self.out_dir, "table.md")) as stream:
+            markdown = stream.read()
+        self.assertIn("| closed | cases | % hidden | IoU default", markdown)
+        medium_part = markdown[markdown.index("## medium"):markdown.index("## all")]
+        self.assertIn("**0.700** ± n/a", medium_part)
+        self.assertNotIn("± 0.000", markdown)
+
+    def test_latex_table(self):
+        self.assertEqual(self.result.returncode, 0, self.result.stdout + self.result.stderr)
+        with open(os.path.join(self.out_dir, "table.tex")) as stream:
+            lines = stream.read().splitlines()
+        body = [line for line in lines if not line.startswith("%")]
+        text = "\n".join(body)
+        for rule in ("\\toprule", "\\midrule", "\\bottomrule", "\\begin{tabular}", "\\end{tabular}"):
+            self.assertIn(rule, text)
+        self.assertIn("my\\_method", text)
+        self.assertIn("hidden (\\%)", text)
+        blocks = text.split("\\multicolumn")[1:]
+        self.assertEqual([block.split("{\\textit{")[1].split(" ")[0] for block in blocks], ["small", "medium", "all"])
+        for block in blocks:
+            rows = [line for line in block.splitlines() if line.endswith("\\\\") and "&" in line]
+            self.assertEqual([row.split(" & ")[0] for row in rows], ["1", "2", "3", "all"], block)
+            self.assertTrue(all("\\textbf{" in row for row in rows), block)
+            self.assertTrue(all(row.count("\\pm") == len(self.METHODS) for row in rows), block)
+        self.assertIn("\\textbf{0.700} $\\pm$ n/a", blocks[1])
+        unescaped = [line for line in body if "%" in line.replace("\\%", "")]
+        self.assertEqual(unescaped, [])
+
+    def test_bad_formats_exit_2_naming_the_format(self):
+        out_dir = os.path.join(self.folder, "bad_formats")
+        result = run_plot(self.results_dir, "--out", out_dir, "--formats", "png,jpeg")
+        self.assertEqual(result.returncode, 2, result.stdout + result.stderr)
+        self.assertIn("jpeg", result.stderr)
+        self.assertIn("--formats", result.stderr)
+        self.assertFalse(os.path.exists(out_dir))
 
 
 class SharedEnvironmentTest(unittest.TestCase):

@@ -2,7 +2,7 @@
 """scripts/explore_worlds end to end on test/data/simulator_corridor.xml (a corridor with two rooms) with door 1
 closed: its own ROS master, simulator + mapper + explorer + pose_logger until the explorer is done, then the
 saved map, the door translated into the map frame, the true room, the prediction and the summary; bad input; and
-the no_growth rule.
+the no_growth rule and the progress status (these two without ROS).
 
 Needs the built package (found like the scripts find it: $CMAKE_PREFIX_PATH, else the checkout's .ws) and
 roslaunch; skips without them, unless HIDDEN_ROOMS_REQUIRE_SHARED=1 (scripts/test.sh), when it fails.
@@ -22,6 +22,7 @@ import yaml
 PACKAGE_DIR = os.path.dirname(os.path.dirname(os.path.dirname(os.path.realpath(__file__))))
 sys.path.insert(0, os.path.join(PACKAGE_DIR, "src"))
 from hidden_rooms import package_tools  # noqa: E402
+from hidden_rooms import explore_worlds  # noqa: E402
 from hidden_rooms.explore_worlds import GrowthStop  # noqa: E402
 
 SCRIPT = os.path.join(PACKAGE_DIR, "scripts", "explore_worlds")
@@ -44,6 +45,32 @@ class GrowthStopTest(unittest.TestCase):
         self.assertEqual([thesis.update(free) for free in (1000, 1005)], [False, True])
         never = GrowthStop(-1, 1)
         self.assertFalse(any(never.update(free) for free in (1000, 900, 0, 0)))
+
+
+class ProgressTest(unittest.TestCase):
+    def test_status_text(self):
+        status = explore_worlds.status_text
+        self.assertEqual(status(None), "starting ROS")
+        self.assertEqual(status({"phase": "starting"}, 100.0), "starting ROS")
+        exploring = {"phase": "exploring", "sim_time": 312.4, "free_area_m2": 85.2, "goals": 12, "maps_saved": 2}
+        self.assertEqual(status(exploring), "mapped 85 m², 12 goals, 2 maps saved")
+        self.assertEqual(status(exploring, 200.0), "mapped 85 m² (43 % of the floor), 12 goals, 2 maps saved")
+        self.assertEqual(status({"phase": "exploring", "free_area_m2": None, "goals": 1, "maps_saved": 1}),
+                         "1 goal, 1 map saved")
+        finishing = dict(exploring, phase="finishing", stop="no_growth")
+        self.assertEqual(status(finishing), "finishing (no_growth), mapped 85 m², 12 goals, 2 maps saved")
+
+    def test_progress_file_round_trip(self):
+        folder = tempfile.mkdtemp(prefix="hidden_rooms_progress_")
+        try:
+            self.assertIsNone(explore_worlds.read_progress(folder))
+            explore_worlds.write_progress(folder, "exploring", 12.345, 7.891, 3, 1)
+            self.assertEqual(explore_worlds.read_progress(folder),
+                             {"phase": "exploring", "sim_time": 12.3, "free_area_m2": 7.89, "goals": 3,
+                              "maps_saved": 1, "stop": None})
+            explore_worlds.write_progress(os.path.join(folder, "missing"), "exploring")  # best effort: no error
+        finally:
+            shutil.rmtree(folder, ignore_errors=True)
 
 
 class ExploreWorldsTest(unittest.TestCase):
@@ -80,6 +107,7 @@ class ExploreWorldsTest(unittest.TestCase):
                      "poses_map.log", "poses_truth.log", "prediction/map.yaml", "prediction/metrics.yaml"):
             self.assertTrue(os.path.isfile(os.path.join(run_dir, name)), name)
         self.assertTrue(os.listdir(os.path.join(run_dir, "maps")), "no map saved at the timeouts")
+        self.assertFalse(os.path.exists(os.path.join(run_dir, "progress.json")), "progress.json left behind")
         with open(os.path.join(run_dir, "doors.yaml")) as doors_file:
             doors = yaml.safe_load(doors_file)["doors"]
         self.assertEqual([door["id"] for door in doors], [1])
