@@ -68,6 +68,21 @@ RoomPredictorNode::RoomPredictorNode(ros::NodeHandle nh, const RoomPredictorOpti
     file_parameters_ = prediction::loadParameterFile(options_.params_file);
     prediction::resolveParameters(*method, file_parameters_);  // throws for a name no method reads
   }
+  method_ = options_.method;
+  parameters_ = file_parameters_;
+  // The live configuration starts from the node's settings (not from the .cfg's defaults).
+  RoomPredictorConfig initial = RoomPredictorConfig::__getDefault__();
+  initial.method = options_.method;
+  dynamic_reconfigure::Config initial_message;
+  initial.__toMessage__(initial_message);
+  for (dynamic_reconfigure::DoubleParameter& parameter : initial_message.doubles)
+    if (file_parameters_.count(parameter.name)) parameter.value = file_parameters_.at(parameter.name);
+  initial.__fromMessage__(initial_message);
+  applied_config_ = initial;
+  reconfigure_server_ = std::make_unique<dynamic_reconfigure::Server<RoomPredictorConfig>>(ros::NodeHandle("~"));
+  reconfigure_server_->updateConfig(initial);
+  reconfigure_server_->setCallback(
+      [this](RoomPredictorConfig& config, uint32_t level) { reconfigure(config, level); });
   map_topic_ = nh.resolveName("map");
   predicted_map_publisher_ = nh.advertise<nav_msgs::OccupancyGrid>("predicted_map", 1, true);
   markers_publisher_ = nh.advertise<visualization_msgs::MarkerArray>("predicted_rooms", 1, true);
@@ -134,6 +149,43 @@ void RoomPredictorNode::predictAndLog(const std::string& why) {
     ROS_INFO("room_predictor: %s: %s", why.c_str(), response.message.c_str());
   else
     ROS_WARN("room_predictor: %s: %s", why.c_str(), response.message.c_str());
+}
+
+void RoomPredictorNode::reconfigure(RoomPredictorConfig& config, uint32_t) {
+  dynamic_reconfigure::Config values, defaults;
+  config.__toMessage__(values);
+  RoomPredictorConfig::__getDefault__().__toMessage__(defaults);
+  std::map<std::string, double> parameters;
+  for (size_t k = 0; k < values.doubles.size(); ++k) {
+    const dynamic_reconfigure::DoubleParameter& parameter = values.doubles[k];
+    if (file_parameters_.count(parameter.name) || parameter.value != defaults.doubles[k].value)
+      parameters[parameter.name] = parameter.value;
+  }
+  const std::string previous_method = method_;
+  const std::map<std::string, double> previous_parameters = parameters_;
+  method_ = config.method;
+  parameters_ = parameters;
+  std::string refused;
+  try {
+    prediction::resolveParameters(*prediction::makeRoomPredictor(method_), parameters_);
+    if (latest_map_ != nullptr && default_doors_ && !default_doors_->doors.empty()) {
+      PredictRooms::Response response;
+      predict(PredictRooms::Request(), &response);
+      ROS_INFO("room_predictor: reconfigured: %s", response.message.c_str());
+    }
+  } catch (const common::InputError& error) {
+    // The method or a parameter value refused; other problems (the map, the doors) are not the settings'.
+    if (error.source() == "method" || error.source().rfind("parameter", 0) == 0) refused = error.what();
+    else ROS_WARN("room_predictor: reconfigured, but the prediction failed: %s", error.what());
+  }
+  if (!refused.empty()) {
+    ROS_WARN("room_predictor: settings not applied: %s", refused.c_str());
+    method_ = previous_method;
+    parameters_ = previous_parameters;
+    config = applied_config_;
+    return;
+  }
+  applied_config_ = config;
 }
 
 void RoomPredictorNode::receiveClick(const geometry_msgs::PointStamped::ConstPtr& click) {
@@ -257,9 +309,9 @@ void RoomPredictorNode::predict(const PredictRooms::Request& request, PredictRoo
   }
   if (core.doors.doors.empty()) throw common::InputError("doors", "no closed doors to predict");
   prediction::checkDoorsInsideMap(core.map, core.doors);
-  core.parameters = file_parameters_;
+  core.parameters = parameters_;
   for (const auto& [name, value] : fromRos(request.parameters)) core.parameters[name] = value;
-  const std::string method = request.method.empty() ? options_.method : request.method;
+  const std::string method = request.method.empty() ? method_ : request.method;
   const std::unique_ptr<prediction::RoomPredictor> predictor = prediction::makeRoomPredictor(method);
 
   const prediction::PredictionResult result = predictor->predict(core);

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <map>
 #include <regex>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -123,6 +124,38 @@ TEST(ParameterDocs, MapPublisherParametersAreDocumentedWithTheirTypesAndDefaults
 
 TEST(ParameterDocs, RoomPredictorParametersAreDocumentedWithTheirTypesAndDefaults) {
   expectDocumented("room_predictor", roomPredictorParameters());
+}
+
+// cfg/RoomPredictor.cfg (rqt_reconfigure) offers every registered method and every parameter some method reads,
+// each with a default that is some method's default.
+TEST(ParameterDocs, RoomPredictorReconfiguresEveryMethodAndParameter) {
+  std::map<std::string, std::set<double>> read;  // parameter -> the methods' defaults
+  for (const std::string& name : prediction::roomPredictorNames())
+    for (const auto& [parameter, value] : prediction::makeRoomPredictor(name)->defaultParameters())
+      read[parameter].insert(value);
+  dynamic_reconfigure::Config defaults;
+  RoomPredictorConfig::__getDefault__().__toMessage__(defaults);
+  std::set<std::string> reconfigurable;
+  for (const dynamic_reconfigure::DoubleParameter& parameter : defaults.doubles) {
+    reconfigurable.insert(parameter.name);
+    EXPECT_TRUE(read.count(parameter.name) && read.at(parameter.name).count(parameter.value))
+        << parameter.name << " = " << parameter.value << " is no method's default";
+  }
+  std::set<std::string> read_names;
+  for (const auto& entry : read) read_names.insert(entry.first);
+  EXPECT_EQ(reconfigurable, read_names);
+
+  std::set<std::string> offered;  // the `method` enum's values
+  for (const dynamic_reconfigure::Group& group : RoomPredictorConfig::__getDescriptionMessage__().groups)
+    for (const dynamic_reconfigure::ParamDescription& parameter : group.parameters)
+      if (parameter.name == "method") {
+        const std::regex value("'value': '([a-z_]+)'");
+        for (std::sregex_iterator it(parameter.edit_method.begin(), parameter.edit_method.end(), value), end;
+             it != end; ++it)
+          offered.insert((*it)[1]);
+      }
+  const std::vector<std::string> names = prediction::roomPredictorNames();
+  EXPECT_EQ(offered, std::set<std::string>(names.begin(), names.end()));
 }
 
 // A YAML value as a parameter of `type` (OptionDescription::type) takes it.

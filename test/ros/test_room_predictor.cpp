@@ -1,6 +1,8 @@
 // rostest: room_predictor on a closed-door benchmark case answers predict_rooms with exactly the rooms of
 // predict_rooms_offline, publishes its overlays latched, answers bad requests with success = false and a clear
-// message, and keeps serving; predict_rooms_client saves the same files as the offline command.
+// message, and keeps serving; predict_rooms_client saves the same files as the offline command; its method and
+// parameters change live through dynamic_reconfigure.
+#include <dynamic_reconfigure/Reconfigure.h>
 #include <gtest/gtest.h>
 #include <geometry_msgs/PointStamped.h>
 #include <hidden_rooms/PredictRooms.h>
@@ -158,6 +160,89 @@ TEST(RoomPredictor, EmptyRequestUsesTheDoorsFileAndTheNodesMethod) {
   ASSERT_TRUE(service.response.success) << service.response.message;
   EXPECT_EQ(service.response.method, "default");
   EXPECT_EQ(service.response.rooms.size(), hidden_rooms::common::loadDoors(caseDir() + "/doors.yaml").doors.size());
+}
+
+// dynamic_reconfigure's set_parameters of the node in namespace `reconfigure`: one string and/or one double.
+dynamic_reconfigure::Config reconfigure(const std::string& method, const std::string& parameter = "",
+                                        double value = 0.0) {
+  dynamic_reconfigure::Reconfigure service;
+  if (!method.empty()) {
+    dynamic_reconfigure::StrParameter text;
+    text.name = "method";
+    text.value = method;
+    service.request.config.strs.push_back(text);
+  }
+  if (!parameter.empty()) {
+    dynamic_reconfigure::DoubleParameter number;
+    number.name = parameter;
+    number.value = value;
+    service.request.config.doubles.push_back(number);
+  }
+  const std::string name = "reconfigure/room_predictor/set_parameters";
+  EXPECT_TRUE(ros::service::waitForService(name, ros::Duration(30.0)) && ros::service::call(name, service)) << name;
+  return service.response.config;
+}
+
+std::string stringOf(const dynamic_reconfigure::Config& config, const std::string& name) {
+  for (const auto& entry : config.strs)
+    if (entry.name == name) return entry.value;
+  return "<missing>";
+}
+
+double doubleOf(const dynamic_reconfigure::Config& config, const std::string& name) {
+  for (const auto& entry : config.doubles)
+    if (entry.name == name) return entry.value;
+  return std::numeric_limits<double>::quiet_NaN();
+}
+
+double totalArea(const PredictRooms::Response& response) {
+  double area = 0.0;
+  for (const auto& room : response.rooms) area += room.area;
+  return area;
+}
+
+TEST(RoomPredictor, MethodAndParametersChangeLiveAndARefusedValueIsPutBack) {
+  REQUIRE_CASE();
+  ros::NodeHandle nh;
+  const auto first = ros::topic::waitForMessage<nav_msgs::OccupancyGrid>("reconfigure/predicted_map", nh,
+                                                                          ros::Duration(30.0));
+  ASSERT_TRUE(first != nullptr) << "the reconfigurable node published no prediction";
+
+  // The method: requests that name none get it, and the node predicts its doors again with it.
+  dynamic_reconfigure::Config config = reconfigure("skewnormal");
+  EXPECT_EQ(stringOf(config, "method"), "skewnormal");
+  const auto again = ros::topic::waitForMessage<nav_msgs::OccupancyGrid>("reconfigure/predicted_map", nh,
+                                                                          ros::Duration(30.0));
+  ASSERT_TRUE(again != nullptr);
+  EXPECT_NE(again->data, first->data) << "the overlays did not change with the method";
+  PredictRooms by_default;
+  ASSERT_TRUE(call(&by_default, "reconfigure/predict_rooms"));
+  ASSERT_TRUE(by_default.response.success) << by_default.response.message;
+  EXPECT_EQ(by_default.response.method, "skewnormal");
+
+  // A parameter: a higher density threshold gives smaller rooms; a request's own value still wins.
+  config = reconfigure("", "skewnormal_p_th", 0.8);
+  EXPECT_DOUBLE_EQ(doubleOf(config, "skewnormal_p_th"), 0.8);
+  PredictRooms tuned, explicit_value;
+  ASSERT_TRUE(call(&tuned, "reconfigure/predict_rooms"));
+  hidden_rooms::PredictionParameter half;
+  half.name = "skewnormal_p_th";
+  half.value = 0.5;
+  explicit_value.request.parameters.push_back(half);
+  ASSERT_TRUE(call(&explicit_value, "reconfigure/predict_rooms"));
+  ASSERT_TRUE(tuned.response.success && explicit_value.response.success);
+  EXPECT_LT(totalArea(tuned.response), totalArea(explicit_value.response));
+  EXPECT_NEAR(totalArea(explicit_value.response), totalArea(by_default.response), 1e-9);
+
+  // A value the method refuses, and an unknown method: both put back, the node keeps the settings before.
+  config = reconfigure("", "skewnormal_p_th", 1.5);
+  EXPECT_DOUBLE_EQ(doubleOf(config, "skewnormal_p_th"), 0.8);
+  config = reconfigure("nosuch");
+  EXPECT_EQ(stringOf(config, "method"), "skewnormal");
+  PredictRooms after;
+  ASSERT_TRUE(call(&after, "reconfigure/predict_rooms"));
+  EXPECT_EQ(after.response.method, "skewnormal");
+  EXPECT_NEAR(totalArea(after.response), totalArea(tuned.response), 1e-9);
 }
 
 TEST(RoomPredictor, PublishesLatchedOverlays) {

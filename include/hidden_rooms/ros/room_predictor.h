@@ -6,8 +6,10 @@
 #include <string>
 #include <vector>
 
+#include <dynamic_reconfigure/server.h>
 #include <geometry_msgs/PointStamped.h>
 #include <hidden_rooms/PredictRooms.h>
+#include <hidden_rooms/RoomPredictorConfig.h>
 #include <hidden_rooms/SaveDoors.h>
 #include <nav_msgs/OccupancyGrid.h>
 #include <ros/ros.h>
@@ -56,7 +58,9 @@ std::vector<common::OptionDescription> roomPredictorParameters();
 RoomPredictorOptions readRoomPredictorOptions(const ros::NodeHandle& private_nh);
 
 // Serves `predict_rooms` (PredictRooms) over the latest map of `map` or the request's own map, and publishes
-// each prediction, latched, as `predicted_map` (the completed map) and `predicted_rooms` (rviz markers).
+// each prediction, latched, as `predicted_map` (the completed map) and `predicted_rooms` (rviz markers). The
+// method and the parameters of requests that name none can be changed live (dynamic_reconfigure,
+// cfg/RoomPredictor.cfg): the node then predicts its own doors again.
 class RoomPredictorNode {
  public:
   // Checks the method, loads the doors and parameters files and slices ~octomap_file (throws InputError naming
@@ -78,10 +82,19 @@ class RoomPredictorNode {
   void predictAndLog(const std::string& why);
   // Predicts and publishes; throws InputError for an unusable request.
   void predict(const PredictRooms::Request& request, PredictRooms::Response* response);
+  // dynamic_reconfigure: takes the method and the parameters (those ~params_file sets, and those that differ from
+  // the .cfg's defaults, i.e. config/*.yaml's) and predicts the node's doors again. A method or value that the
+  // prediction refuses puts `config` back to the settings before, with a warning naming it.
+  void reconfigure(RoomPredictorConfig& config, uint32_t level);
 
   RoomPredictorOptions options_;
   std::optional<common::DoorsFile> default_doors_;  // the doors of requests without doors: file, then clicks
-  std::map<std::string, double> file_parameters_;
+  std::map<std::string, double> file_parameters_;  // ~params_file's
+  // The method and parameter overrides of requests that name none: ~method and ~params_file, then reconfigured.
+  std::string method_;
+  std::map<std::string, double> parameters_;
+  RoomPredictorConfig applied_config_;  // the configuration method_ and parameters_ come from
+  std::unique_ptr<dynamic_reconfigure::Server<RoomPredictorConfig>> reconfigure_server_;
   nav_msgs::OccupancyGrid::ConstPtr latest_map_;
   std::string map_topic_;
   ros::Subscriber map_subscriber_;
