@@ -24,6 +24,7 @@ const common::OptionTable<ExplorerOptions>& explorerNodeOptionTable() {
       {"pose_timeout", &O::pose_timeout, "seconds: an older map -> base transform stops the robot",
        common::above(0)},
       {"map_timeout", &O::map_timeout, "seconds without a new map stop the robot; 0 = never", common::atLeast(0)},
+      {"start_paused", &O::start_paused, "wait for true on ~resume before exploring"},
   };
   return table;
 }
@@ -62,6 +63,9 @@ Explorer::Explorer(ros::NodeHandle nh, const ExplorerOptions& options)
     : options_(options), policy_(options), tf_buffer_(ros::Duration(10.0)), tf_listener_(tf_buffer_) {
   map_subscriber_ = nh.subscribe("map", 1, &Explorer::onMap, this);
   scan_subscriber_ = nh.subscribe("scan", 1, &Explorer::onScan, this);
+  resume_subscriber_ = ros::NodeHandle("~").subscribe("resume", 10, &Explorer::onResume, this);
+  paused_ = options.start_paused;
+  if (paused_) ROS_INFO("explorer: paused until true on %s", resume_subscriber_.getTopic().c_str());
   command_publisher_ = nh.advertise<geometry_msgs::Twist>("cmd_vel", 1);
   done_publisher_ = nh.advertise<std_msgs::Bool>("exploration_done", 1, true);
   markers_publisher_ = nh.advertise<visualization_msgs::MarkerArray>("exploration_markers", 1, true);
@@ -108,6 +112,15 @@ void Explorer::onScan(const sensor_msgs::LaserScan::ConstPtr& scan) {
   }
 }
 
+void Explorer::onResume(const std_msgs::Bool::ConstPtr& resume) {
+  if (paused_ == !resume->data) return;
+  paused_ = !resume->data;
+  if (paused_)
+    ROS_INFO("explorer: paused (true on %s resumes)", resume_subscriber_.getTopic().c_str());
+  else
+    ROS_INFO("explorer: resumed");
+}
+
 bool Explorer::robotPose(common::Pose2* pose) {
   try {
     const geometry_msgs::TransformStamped transform =
@@ -135,6 +148,10 @@ void Explorer::onTimer(const ros::TimerEvent&) {
   const ros::Time now = ros::Time::now();
   if (!latest_map_) {
     ROS_INFO_THROTTLE(10.0, "explorer: waiting for a map on %s", map_subscriber_.getTopic().c_str());
+    return;
+  }
+  if (paused_) {
+    holdRobot(now);
     return;
   }
   common::Pose2 pose;

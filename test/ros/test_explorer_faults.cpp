@@ -1,6 +1,8 @@
 // rostest of the explorer under faults (test/explorer_faults.test). The test publishes a fixed map every second of
 // simulated time (the world rendered, the rooms unknown: frontiers in both doorways) and relays the explorer's
 // commands (explorer_cmd_vel) to the simulator (cmd_vel). While the robot drives to a doorway:
+//  0. the exploration is paused (false on /explorer/resume) for longer than the follower's timeouts: the robot
+//     stops at once; resumed (true), it drives on, without a recovery or a failed goal caused by the pause;
 //  1. the map stops (the mapper died) for longer than the follower's progress and stall timeouts: within
 //     ~map_timeout the explorer stops the robot and warns; when maps come again it drives on, without a recovery
 //     or a failed goal caused by the pause;
@@ -132,11 +134,33 @@ class ExplorerFaultsTest : public ::testing::Test {
   std::vector<rosgraph_msgs::Log::ConstPtr> log_;
 };
 
-TEST_F(ExplorerFaultsTest, StopsWithoutMapsAndRecoversWhenPinned) {
+TEST_F(ExplorerFaultsTest, PausesStopsWithoutMapsAndRecoversWhenPinned) {
   // Exploring: the robot drives towards a doorway.
   ASSERT_TRUE(waitFor([this] { return position().has_value(); }, 30.0)) << "no ground truth from the simulator";
   const common::Point2 start = *position();
   ASSERT_TRUE(waitFor([&] { return movedFrom(start, 0.3); }, 30.0)) << "the explorer did not drive";
+
+  // 0. Paused for 9 simulated seconds, beyond progress_timeout (6 s) and stall_timeout (1 s).
+  ros::Publisher resume = nh_.advertise<std_msgs::Bool>("explorer/resume", 1, true);
+  std_msgs::Bool flag;
+  flag.data = false;
+  resume.publish(flag);
+  const double paused = ros::Time::now().toSec();
+  ASSERT_TRUE(waitUntilSimTime(paused + 9.0, 30.0));
+  const double paused_by = paused + 0.5;  // a control period (0.1 s) and the message's way
+  for (const TimedCommand& command : commands_)
+    if (command.time > paused_by)
+      EXPECT_TRUE(command.linear == 0.0 && command.angular == 0.0)
+          << "moving command " << command.linear << ", " << command.angular << " at " << command.time
+          << " s, paused at " << paused << " s";
+  EXPECT_LT(motionBetween(paused_by + 1.0, paused + 9.0), 0.03) << "the robot did not stop when paused";
+  flag.data = true;
+  resume.publish(flag);
+  const double unpaused = ros::Time::now().toSec();
+  const common::Point2 unpaused_at = *position();
+  ASSERT_TRUE(waitFor([&] { return movedFrom(unpaused_at, 0.3); }, 20.0)) << "no driving after resume";
+  EXPECT_EQ(explorerWarnings("not reached", paused, unpaused + 1.5), 0) << "the pause failed the goal";
+  EXPECT_EQ(explorerWarnings("did not move", paused, unpaused + 1.5), 0) << "the pause failed the goal";
 
   // 1. No map for 11 simulated seconds: the robot stands still for more than 8 s, beyond the follower's
   // progress_timeout (6 s) and stall_timeout (1 s) of the launch file.

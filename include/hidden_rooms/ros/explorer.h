@@ -7,6 +7,7 @@
 #include <nav_msgs/OccupancyGrid.h>
 #include <ros/ros.h>
 #include <sensor_msgs/LaserScan.h>
+#include <std_msgs/Bool.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
 
@@ -24,6 +25,7 @@ struct ExplorerOptions : exploration::ExplorationPolicyOptions {
   double scan_timeout = 1.0;        // seconds (ROS time): an older scan stops the robot
   double pose_timeout = 1.0;        // seconds (ROS time): an older map -> base transform stops the robot
   double map_timeout = 10.0;        // seconds (ROS time) without a new map (mapper down) stop the robot; 0 = never
+  bool start_paused = false;        // wait for true on ~resume before exploring
 };
 
 // The node's own parameters (frames, rates, timeouts); the policy's are in the core's tables.
@@ -36,7 +38,8 @@ ExplorerOptions readExplorerOptions(const ros::NodeHandle& private_nh);
 // Nearest-frontier exploration (replaces explore + move_base) with the core's ExplorationPolicy on the latest
 // `map`, the robot's pose from tf and the laser on `base_scan`: publishes its commands on `cmd_vel`, its state on
 // `exploration_markers` and the latched `exploration_done`, and logs its events. Stops (and holds the policy)
-// while the map, the pose or the scan is stale.
+// while the map, the pose or the scan is stale, and while paused: false on `~resume` (std_msgs/Bool, as
+// explore_lite's resume topic) pauses, true resumes with the same goal and blacklist.
 class Explorer {
  public:
   // Subscribes and advertises; does not wait for anything (the control timer does the work).
@@ -47,6 +50,7 @@ class Explorer {
  private:
   void onMap(const nav_msgs::OccupancyGrid::ConstPtr& map);
   void onScan(const sensor_msgs::LaserScan::ConstPtr& scan);
+  void onResume(const std_msgs::Bool::ConstPtr& resume);
   void onTimer(const ros::TimerEvent& event);
   bool robotPose(common::Pose2* pose);
   // Stops the robot from outside the policy (stale map, pose or scan): the follower's timers do not count it.
@@ -67,12 +71,14 @@ class Explorer {
   std::vector<common::Point2> scan_points_;  // latest scan's returns in base_frame
   bool scan_remembered_ = true;      // the latest scan was given to the policy
   bool stopped_ = true;  // the last command sent was a stop
+  bool paused_ = false;  // by ~resume (or ~start_paused)
   // Statistics for the log.
   std::optional<common::Pose2> last_pose_;
   double distance_driven_ = 0.0;
   int goals_chosen_ = 0;
   ros::Subscriber map_subscriber_;
   ros::Subscriber scan_subscriber_;
+  ros::Subscriber resume_subscriber_;
   ros::Publisher command_publisher_;
   ros::Publisher done_publisher_;
   ros::Publisher markers_publisher_;
