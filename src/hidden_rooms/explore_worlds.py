@@ -50,6 +50,7 @@ MASTER_START_TIMEOUT = 60.0   # wall seconds for roslaunch's master and the simu
 PR_SET_PDEATHSIG = 1          # prctl option (linux/prctl.h)
 STALL_TIMEOUT = 60.0          # wall seconds without simulated time advancing: the run is stuck
 SHUTDOWN_TIMEOUT = 20.0       # wall seconds for roslaunch to stop after SIGINT
+WALL_CLOCK_EPOCH = 1e8         # seconds: no simulated run gets this far; wall-clock time (since 1970) is beyond
 PROGRESS_INTERVAL = 1.0       # wall seconds between two writes of progress.json (worker) and two bar updates
 
 
@@ -263,6 +264,24 @@ def wait_for_master(launch, deadline):
     raise RuntimeError("no ROS master after %.0f s" % MASTER_START_TIMEOUT)
 
 
+def wait_for_simulated_time(launch, deadline):
+    """Waits until roslaunch has set /use_sim_time true. rospy reads it once, in init_node: a node started on the
+    master before the launch file's parameters are set takes wall-clock time for ROS time (the run would stop at
+    once with max_time, its simulated time an epoch)."""
+    import rosgraph
+    master = rosgraph.Master("/explore_worlds")
+    while time.monotonic() < deadline:
+        if launch.poll() is not None:
+            raise RuntimeError("roslaunch exited with code %d before it set /use_sim_time" % launch.returncode)
+        try:
+            if master.getParam("/use_sim_time") is True:
+                return
+        except (rosgraph.MasterException, OSError):
+            pass  # not set yet
+        time.sleep(0.1)
+    raise RuntimeError("/use_sim_time not set %.0f s after the master came up" % MASTER_START_TIMEOUT)
+
+
 def stop_launch(launch):
     if launch.poll() is None:
         launch.send_signal(signal.SIGINT)
@@ -306,7 +325,11 @@ def explore(args, out_dir, log):
                               preexec_fn=die_with_parent)
     try:
         wait_for_master(launch, time.monotonic() + MASTER_START_TIMEOUT)
+        wait_for_simulated_time(launch, time.monotonic() + MASTER_START_TIMEOUT)
         run = Run(world_name(args.world))
+        if run.sim_time() > WALL_CLOCK_EPOCH:
+            raise RuntimeError("ROS time reads as wall-clock time (%.0f s): /use_sim_time was not seen"
+                               % run.sim_time())
         status, saved = None, 0
         growth_stop = GrowthStop(args.growth, args.patience)
         next_save = args.timeout

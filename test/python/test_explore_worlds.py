@@ -1,8 +1,9 @@
 #!/usr/bin/python3
 """scripts/explore_worlds end to end on test/data/simulator_corridor.xml (a corridor with two rooms) with door 1
 closed: its own ROS master, simulator + mapper + explorer + pose_logger until the explorer is done, then the
-saved map, the door translated into the map frame, the true room, the prediction and the summary; bad input; and
-the no_growth rule and the progress status (these two without ROS).
+saved map, the door translated into the map frame, the true room, the prediction and the summary; short runs back to
+back, each starting its simulated time near 0; bad input; the wait for /use_sim_time (on a bare master); and the
+no_growth rule and the progress status (these two without ROS).
 
 Needs the built package (found like the scripts find it: $CMAKE_PREFIX_PATH, else the checkout's .ws) and
 roslaunch; skips without them, unless HIDDEN_ROOMS_REQUIRE_SHARED=1 (scripts/test.sh), when it fails.
@@ -71,6 +72,57 @@ class ProgressTest(unittest.TestCase):
             explore_worlds.write_progress(os.path.join(folder, "missing"), "exploring")  # best effort: no error
         finally:
             shutil.rmtree(folder, ignore_errors=True)
+
+
+class SimulatedTimeWaitTest(unittest.TestCase):
+    """wait_for_simulated_time against a bare master: it returns only once /use_sim_time is set."""
+
+    class RunningLaunch:
+        def poll(self):
+            return None
+
+    def setUp(self):
+        try:
+            import rosgraph  # noqa: F401
+        except ImportError as error:
+            if os.environ.get("HIDDEN_ROOMS_REQUIRE_SHARED") == "1":
+                raise AssertionError("rosgraph missing: %s" % error)
+            raise unittest.SkipTest(str(error))
+        port = explore_worlds.free_port()
+        self.previous_uri = os.environ.get("ROS_MASTER_URI")
+        os.environ["ROS_MASTER_URI"] = "http://127.0.0.1:%d" % port
+        self.master = subprocess.Popen(["rosmaster", "--core", "-p", str(port)], stdout=subprocess.DEVNULL,
+                                       stderr=subprocess.DEVNULL)
+        explore_worlds.wait_for_master(self.RunningLaunch(), time.monotonic() + 30.0)
+
+    def tearDown(self):
+        self.master.terminate()
+        self.master.wait(timeout=30)
+        if self.previous_uri is None:
+            os.environ.pop("ROS_MASTER_URI", None)
+        else:
+            os.environ["ROS_MASTER_URI"] = self.previous_uri
+
+    def test_waits_for_use_sim_time(self):
+        import rosgraph
+        import threading
+        waiter = threading.Thread(target=explore_worlds.wait_for_simulated_time,
+                                  args=(self.RunningLaunch(), time.monotonic() + 30.0))
+        waiter.start()
+        waiter.join(1.5)
+        self.assertTrue(waiter.is_alive(), "returned before /use_sim_time was set")
+        rosgraph.Master("/test").setParam("/use_sim_time", True)
+        waiter.join(5.0)
+        self.assertFalse(waiter.is_alive(), "still waiting with /use_sim_time set")
+
+    def test_a_launch_that_ends_first_is_reported(self):
+        class EndedLaunch:
+            returncode = 1
+
+            def poll(self):
+                return 1
+        with self.assertRaisesRegex(RuntimeError, "before it set /use_sim_time"):
+            explore_worlds.wait_for_simulated_time(EndedLaunch(), time.monotonic() + 5.0)
 
 
 class ExploreWorldsTest(unittest.TestCase):
@@ -156,6 +208,32 @@ class ExploreWorldsTest(unittest.TestCase):
         """Command lines of running processes that name `out` (the worker, roslaunch and its nodes)."""
         found = subprocess.run(["pgrep", "-af", out], capture_output=True, text=True).stdout
         return [line for line in found.splitlines() if "pgrep" not in line]
+
+    def test_short_runs_back_to_back_start_their_simulated_time_near_zero(self):
+        # Each run its own master; the driver must read simulated time, never the wall clock (a race with the
+        # launch file's /use_sim_time once stopped a run at once with max_time and an epoch as simulated time).
+        folder = tempfile.mkdtemp(prefix="hidden_rooms_explore_worlds_starts_")
+        try:
+            worlds = []
+            for k in range(6):
+                worlds.append(os.path.join(folder, "corridor_%d.xml" % k))
+                shutil.copy(WORLD, worlds[-1])
+            result = run(*worlds, "--out", os.path.join(folder, "out"), "--max-time", "6", "--method", "",
+                         "--jobs", "2", "--no-progress", timeout=300)
+            self.assertEqual(result.returncode, 0, result.stdout + result.stderr)
+            with open(os.path.join(folder, "out", "summary.csv")) as summary_file:
+                rows = list(csv.DictReader(summary_file))
+            self.assertEqual(len(rows), len(worlds))
+            for row in rows:
+                self.assertEqual(row["status"], "max_time", row)
+                self.assertTrue(6.0 <= float(row["sim_time_s"]) < 9.0, row)
+                poses = os.path.join(folder, "out", os.path.splitext(os.path.basename(row["world"]))[0],
+                                     "poses_truth.log")
+                with open(poses) as poses_file:
+                    first = next(line for line in poses_file if not line.startswith("#"))
+                self.assertLess(float(first.split()[0]), 3.0, "%s starts at %s" % (poses, first))
+        finally:
+            shutil.rmtree(folder, ignore_errors=True)
 
     def test_bad_input_exits_2_with_a_message(self):
         missing = run(os.path.join(self.out, "no_such_world.xml"), "--out", self.out)
