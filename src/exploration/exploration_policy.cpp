@@ -44,6 +44,10 @@ ExplorationPolicy::ExplorationPolicy(const ExplorationPolicyOptions& options)
   blacklist_.radius = options.blacklist_radius;
 }
 
+ExplorationPolicy::~ExplorationPolicy() {
+  if (background_plan_.valid()) background_plan_.wait();
+}
+
 void ExplorationPolicy::setMap(const common::OccupancyGrid& map) {
   next_map_ = map;
   pending_map_ = PendingMap::kUsable;
@@ -72,6 +76,11 @@ ExplorationStep ExplorationPolicy::update(const common::Pose2& pose, double time
   const bool recovering = state == FollowerState::kBackingOff || state == FollowerState::kRecoveryRotating;
   const bool replan_due =
       options_.replan_interval > 0.0 && time - last_plan_ >= options_.replan_interval - kTimeEpsilon;
+  if (background_plan_.valid() &&
+      background_plan_.wait_for(std::chrono::seconds(0)) == std::future_status::ready) {
+    choose(background_plan_.get(), pose, time, &step);
+    goal_ended_ = false;
+  }
   if (!recovering && (pending_map_ != PendingMap::kNone || replan_due)) plan(pose, time, &step);
 
   if (goal_) {
@@ -87,6 +96,7 @@ ExplorationStep ExplorationPolicy::update(const common::Pose2& pose, double time
       return step;
     }
   }
+  if (goal_ended_) return step;  // stand still until the plan for the next goal is in
   // No goal: turn in place to look around until a frontier shows up or done is confirmed.
   if (!done_) step.command.angular = options_.search_angular_velocity;
   return step;
@@ -122,7 +132,24 @@ void ExplorationPolicy::finishGoal(const common::Pose2& pose, FollowerState outc
   goal_.reset();
 }
 
+ExplorationPolicy::CostMap ExplorationPolicy::computeCostMap(const GridPlannerOptions& planner_options,
+                                                             const FrontierOptions& frontier_options,
+                                                             const std::vector<common::Point2>& blocked_points,
+                                                             double blocked_radius, const common::OccupancyGrid& map,
+                                                             const common::Point2& robot, bool new_map) {
+  CostMap result{GridPlanner(planner_options), FrontierMap(), false, new_map};
+  result.planner.setBlockedPoints(blocked_points, blocked_radius);
+  result.planner.setMap(map);
+  result.frontiers = findFrontiers(result.planner.map(), frontier_options);
+  result.start_reachable = result.planner.computeCostsFrom(robot);
+  return result;
+}
+
 void ExplorationPolicy::plan(const common::Pose2& pose, double time, ExplorationStep* step) {
+  if (background_plan_.valid()) {  // one at a time: a goal that ended waits for the running plan
+    goal_ended_ = goal_ended_ || !goal_;
+    return;
+  }
   last_plan_ = time;
   const PendingMap pending = pending_map_;
   pending_map_ = PendingMap::kNone;
@@ -133,14 +160,28 @@ void ExplorationPolicy::plan(const common::Pose2& pose, double time, Exploration
     return;
   }
   const bool new_map = pending == PendingMap::kUsable;
-  if (new_map) {
-    planner_.setMap(next_map_);
-    next_map_ = common::OccupancyGrid();
-  }
+  const common::OccupancyGrid map = new_map ? next_map_ : planner_.map();
+  if (new_map) next_map_ = common::OccupancyGrid();
   const common::Point2 robot(pose.x, pose.y);
-  frontiers_ = findFrontiers(planner_.map(), options_.frontiers);
+  if (!options_.background_planning) {
+    choose(computeCostMap(options_.planner, options_.frontiers, passages_.blockedPoints(), options_.passages.radius,
+                          map, robot, new_map),
+           pose, time, step);
+    return;
+  }
+  goal_ended_ = !goal_;
+  background_plan_ = std::async(std::launch::async, &ExplorationPolicy::computeCostMap, options_.planner,
+                                options_.frontiers, passages_.blockedPoints(), options_.passages.radius, map, robot,
+                                new_map);
+}
+
+void ExplorationPolicy::choose(CostMap cost_map, const common::Pose2& pose, double time, ExplorationStep* step) {
+  planner_ = std::move(cost_map.planner);
+  frontiers_ = std::move(cost_map.frontiers);
+  const bool new_map = cost_map.new_map;
+  const common::Point2 robot(pose.x, pose.y);
   step->planned = true;
-  if (!planner_.computeCostsFrom(robot)) {
+  if (!cost_map.start_reachable) {
     step->events.push_back(event(ExplorationEventType::kStartBlocked, robot));
     return;
   }

@@ -25,6 +25,8 @@ const common::OptionTable<ExplorerOptions>& explorerNodeOptionTable() {
        common::above(0)},
       {"map_timeout", &O::map_timeout, "seconds without a new map stop the robot; 0 = never", common::atLeast(0)},
       {"start_paused", &O::start_paused, "wait for true on ~resume before exploring"},
+      {"background_planning", static_cast<bool O::*>(&O::background_planning),
+       "plan on a thread of its own while the robot follows its path; false = in the control loop (deterministic)"},
   };
   return table;
 }

@@ -1,8 +1,12 @@
 // The exploration policy on a synthetic corridor: the goal and the drive to it, the blacklist of reached and failed
-// goals, the second try, the release order of blocked goals, done after the confirmations, the goal hysteresis.
+// goals, the second try, the release order of blocked goals, done after the confirmations, the goal hysteresis, the
+// plan in the background.
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <functional>
+#include <thread>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -129,6 +133,53 @@ TEST(ExplorationPolicy, ChoosesTheNearestFrontierAndDrivesThere) {
   EXPECT_NEAR(first(step, Type::kGoalReached).position.x(), kRightGoalX, 1e-9);
   EXPECT_LT(std::hypot(pose.x - kRightGoalX, pose.y - kCentreY), policy.options().follower.goal_tolerance + 0.06);
   EXPECT_LT(time, 2.0 * (kRightGoalX - 5.05) / policy.options().follower.max_linear_velocity);
+}
+
+// With background_planning the plan runs on a thread of its own: the robot stands still until the first plan is in,
+// then follows its path; a slow plan (a 200 m x 200 m map, seconds of wavefront) does not hold up the commands.
+TEST(ExplorationPolicy, ABackgroundPlanDoesNotHoldUpTheControlLoop) {
+  ExplorationPolicyOptions options;
+  options.background_planning = true;
+  options.replan_interval = 0.0;
+  ExplorationPolicy policy(options);
+  policy.setMap(corridor(false, true));
+  common::Pose2 pose{5.05, kCentreY, 0.0};
+  double time = 0.1;
+  ExplorationStep step = policy.update(pose, time);
+  EXPECT_FALSE(step.planned);
+  EXPECT_EQ(step.command.linear, 0.0);  // no goal yet: it waits for the plan
+  EXPECT_EQ(step.command.angular, 0.0);
+  for (int k = 0; k < 10000 && !step.planned; ++k) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    step = policy.update(pose, time);
+  }
+  ASSERT_TRUE(step.planned);
+  ASSERT_TRUE(has(step, Type::kGoalChosen));
+  EXPECT_NEAR(first(step, Type::kGoalChosen).position.x(), kRightGoalX, 1e-9);
+  EXPECT_GT(step.command.linear, 0.0);
+
+  common::OccupancyGrid large;
+  large.resolution = 0.1;
+  large.cells = cv::Mat_<int8_t>(2000, 2000, common::OccupancyGrid::kFree);
+  large.cells(cv::Rect(0, 0, 2000, 1)).setTo(common::OccupancyGrid::kOccupied);
+  large.cells(cv::Rect(0, 1999, 2000, 1)).setTo(common::OccupancyGrid::kOccupied);
+  large.cells(cv::Rect(0, 0, 1, 2000)).setTo(common::OccupancyGrid::kOccupied);
+  large.cells(cv::Rect(1990, 1, 10, 1998)).setTo(common::OccupancyGrid::kUnknown);  // the frontier, 199 m away
+  policy.setMap(large);
+  int moving_while_planning = 0;
+  step = ExplorationStep();
+  for (int k = 0; k < 100000 && !step.planned; ++k) {  // about real time: 1 ms a step
+    step = policy.update(pose, time += 0.001);
+    pose.x += 0.001 * step.command.linear;
+    if (!step.planned) {
+      EXPECT_GT(step.command.linear, 0.0) << "the robot stopped while the plan ran, at update " << k;
+      ++moving_while_planning;
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+  }
+  ASSERT_TRUE(step.planned) << "the plan on the large map never came in";
+  EXPECT_GT(moving_while_planning, 0) << "update() waited for the plan";
+  std::printf("%d updates steered while the large map's plan ran\n", moving_while_planning);
 }
 
 TEST(ExplorationPolicy, AReachedGoalIsBlacklisted) {

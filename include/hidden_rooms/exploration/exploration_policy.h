@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstddef>
+#include <future>
 #include <optional>
 #include <string>
 #include <vector>
@@ -27,6 +28,10 @@ struct ExplorationPolicyOptions {
   int done_confirmations = 3;       // plans on new maps in a row without a reachable frontier before done
   double search_angular_velocity = 0.4;  // rad/s turned in place while there is no goal (and not done)
   double obstacle_memory = 1.5;     // seconds laser points are remembered (for the robot's blind rear)
+  // The costly part of a plan (the map's cost map, the frontiers, the costs from the robot) on a thread of its
+  // own, so that update() keeps steering along the current path meanwhile; the goal is chosen at the first update
+  // after it finished. Off: update() plans in place (deterministic: the same inputs give the same commands).
+  bool background_planning = false;
 };
 
 // The explorer's parameters of the policy itself (docs/ros_api.md); the nested options have tables of their own.
@@ -79,10 +84,15 @@ struct ExplorationStep {
 // goals are released in this order, each only when the ones before gave no goal: the places where the robot was
 // stuck, the blocked passages (once), the failed places (their one second try). Done after done_confirmations
 // plans on new maps in a row without a goal; until then, and without a goal, it turns in place. Times are seconds
-// of a monotonic clock (the node uses ROS time); differences within half a nanosecond count as equal.
+// of a monotonic clock (the node uses ROS time); differences within half a nanosecond count as equal. With
+// background_planning, a plan started at one update is used at the first update after it finished (the robot
+// keeps following its path meanwhile, and stands still when its goal ended); one plan runs at a time.
 class ExplorationPolicy {
  public:
   explicit ExplorationPolicy(const ExplorationPolicyOptions& options = ExplorationPolicyOptions());
+  ~ExplorationPolicy();  // waits for a plan running in the background
+  ExplorationPolicy(const ExplorationPolicy&) = delete;
+  ExplorationPolicy& operator=(const ExplorationPolicy&) = delete;
 
   // A new map (map frame): the next step plans with it.
   void setMap(const common::OccupancyGrid& map);
@@ -108,8 +118,21 @@ class ExplorationPolicy {
 
  private:
   enum class PendingMap { kNone, kUsable, kUnusable };
-  // Chooses a goal and a path from `pose`, releasing blocked goals when none is left; counts towards done.
+  // The costly part of a plan, on a planner of its own (safe on another thread).
+  struct CostMap {
+    GridPlanner planner;
+    FrontierMap frontiers;
+    bool start_reachable = false;
+    bool new_map = false;
+  };
+  static CostMap computeCostMap(const GridPlannerOptions& planner_options, const FrontierOptions& frontier_options,
+                                const std::vector<common::Point2>& blocked_points, double blocked_radius,
+                                const common::OccupancyGrid& map, const common::Point2& robot, bool new_map);
+  // Starts a plan from `pose` (in the background or in place): takes the pending map, if any.
   void plan(const common::Pose2& pose, double time, ExplorationStep* step);
+  // Takes a finished cost map, chooses a goal and a path from `pose`, releasing blocked goals when none is left;
+  // counts towards done.
+  void choose(CostMap cost_map, const common::Pose2& pose, double time, ExplorationStep* step);
   // Blacklists the goal that just ended (reached or failed) and records failed passages.
   void finishGoal(const common::Pose2& pose, FollowerState outcome, ExplorationStep* step);
 
@@ -125,6 +148,8 @@ class ExplorationPolicy {
   FrontierMap frontiers_;
   std::optional<FrontierGoal> goal_;
   double last_plan_ = 0.0;  // time of the last plan (0 before the first, as ROS time starts)
+  std::future<CostMap> background_plan_;  // valid while a plan runs in the background
+  bool goal_ended_ = false;  // the goal ended and the plan for the next one is still running
   int plans_without_goal_ = 0;
   bool done_ = false;
 };

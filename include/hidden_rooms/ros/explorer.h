@@ -19,6 +19,7 @@ namespace hidden_rooms {
 // policy's (planner, frontiers, follower, passages, replanning, hysteresis, blacklist, done, search turn, obstacle
 // memory) and the node's own.
 struct ExplorerOptions : exploration::ExplorationPolicyOptions {
+  ExplorerOptions() { background_planning = true; }  // plans never hold up cmd_vel (~background_planning)
   std::string map_frame = "map";
   std::string base_frame = "base_link";
   double control_rate = 10.0;       // Hz of ROS time: commands (and replanning when due)
