@@ -132,16 +132,18 @@ void ExplorationPolicy::finishGoal(const common::Pose2& pose, FollowerState outc
   goal_.reset();
 }
 
-ExplorationPolicy::CostMap ExplorationPolicy::computeCostMap(const GridPlannerOptions& planner_options,
-                                                             const FrontierOptions& frontier_options,
+ExplorationPolicy::CostMap ExplorationPolicy::computeCostMap(const ExplorationPolicyOptions& options,
+                                                             const Blacklist& blacklist,
                                                              const std::vector<common::Point2>& blocked_points,
-                                                             double blocked_radius, const common::OccupancyGrid& map,
+                                                             const common::OccupancyGrid& map,
                                                              const common::Point2& robot, bool new_map) {
-  CostMap result{GridPlanner(planner_options), FrontierMap(), false, new_map};
-  result.planner.setBlockedPoints(blocked_points, blocked_radius);
+  CostMap result{GridPlanner(options.planner), FrontierMap(), false, new_map};
+  result.planner.setBlockedPoints(blocked_points, options.passages.radius);
   result.planner.setMap(map);
-  result.frontiers = findFrontiers(result.planner.map(), frontier_options);
-  result.start_reachable = result.planner.computeCostsFrom(robot);
+  result.frontiers = findFrontiers(result.planner.map(), options.frontiers);
+  const cv::Mat1b targets = goalCandidates(result.frontiers, result.planner, blacklist, options.frontiers, robot,
+                                           options.planner.start_escape_radius);
+  result.start_reachable = result.planner.computeCostsFrom(robot, targets, options.goal_hysteresis);
   return result;
 }
 
@@ -164,15 +166,12 @@ void ExplorationPolicy::plan(const common::Pose2& pose, double time, Exploration
   if (new_map) next_map_ = common::OccupancyGrid();
   const common::Point2 robot(pose.x, pose.y);
   if (!options_.background_planning) {
-    choose(computeCostMap(options_.planner, options_.frontiers, passages_.blockedPoints(), options_.passages.radius,
-                          map, robot, new_map),
-           pose, time, step);
+    choose(computeCostMap(options_, blacklist_, passages_.blockedPoints(), map, robot, new_map), pose, time, step);
     return;
   }
   goal_ended_ = !goal_;
-  background_plan_ = std::async(std::launch::async, &ExplorationPolicy::computeCostMap, options_.planner,
-                                options_.frontiers, passages_.blockedPoints(), options_.passages.radius, map, robot,
-                                new_map);
+  background_plan_ = std::async(std::launch::async, &ExplorationPolicy::computeCostMap, options_, blacklist_,
+                                passages_.blockedPoints(), map, robot, new_map);
 }
 
 void ExplorationPolicy::choose(CostMap cost_map, const common::Pose2& pose, double time, ExplorationStep* step) {
@@ -194,6 +193,11 @@ void ExplorationPolicy::choose(CostMap cost_map, const common::Pose2& pose, doub
                                options_.goal_hysteresis);
   };
   std::optional<FrontierGoal> goal = nearest();
+  if (!goal && planner_.searchWasBounded()) {
+    // The bound was set by a candidate blacklisted since the plan started (in the background): costs everywhere.
+    planner_.computeCostsFrom(robot);
+    goal = nearest();
+  }
   if (!goal && !blacklist_.stuck_points.empty()) {
     // Not done while the only goals left failed because the robot could not move: try them again (their
     // recoveries are what may free the robot).

@@ -230,4 +230,29 @@ std::optional<FrontierGoal> nearestFrontierGoal(const FrontierMap& frontiers, co
   return FrontierGoal{claimed(row, col), {col, row}, map.cellCentre(col, row), cost};
 }
 
+cv::Mat1b goalCandidates(const FrontierMap& frontiers, const GridPlanner& planner, const Blacklist& blacklist,
+                         const FrontierOptions& options, const common::Point2& robot, double extra_distance) {
+  const common::OccupancyGrid& map = planner.map();
+  cv::Mat1b candidates = cv::Mat1b::zeros(map.height(), map.width());
+  if (map.empty()) return candidates;
+  for (const Frontier& frontier : frontiers.frontiers)
+    for (const cv::Point& cell : frontier.cells) candidates(cell) = 255;
+  // Within goal_reach of a frontier cell, as nearestFrontierGoal measures it (whole cells, centre to centre).
+  const int reach = static_cast<int>(std::floor(options.goal_reach / map.resolution));
+  cv::Mat1b disc = cv::Mat1b::zeros(2 * reach + 1, 2 * reach + 1);
+  for (int row = 0; row <= 2 * reach; ++row)
+    for (int col = 0; col <= 2 * reach; ++col)
+      disc(row, col) = (col - reach) * (col - reach) + (row - reach) * (row - reach) <= reach * reach ? 1 : 0;
+  cv::dilate(candidates, candidates, disc, cv::Point(-1, -1), 1, cv::BORDER_CONSTANT, cv::Scalar(0));
+  candidates &= planner.roomy();
+  const double min_distance = options.min_goal_distance + extra_distance;
+  for (int row = 0; row < candidates.rows; ++row)
+    for (int col = 0; col < candidates.cols; ++col) {
+      if (candidates(row, col) == 0) continue;
+      const common::Point2 position = map.cellCentre(col, row);
+      if ((position - robot).norm() < min_distance || blacklist.contains(position)) candidates(row, col) = 0;
+    }
+  return candidates;
+}
+
 }  // namespace hidden_rooms::exploration

@@ -106,10 +106,11 @@ void GridPlanner::setBlockedPoints(const std::vector<common::Point2>& points, do
   setMap(map);
 }
 
-bool GridPlanner::computeCostsFrom(const common::Point2& start) {
+bool GridPlanner::computeCostsFrom(const common::Point2& start, const cv::Mat1b& targets, double margin) {
   cost_.setTo(kInfinity);
   parent_.setTo(-1);
   start_cell_ = {-1, -1};
+  search_bounded_ = false;
   int start_col = 0, start_row = 0;
   if (map_.empty() || !map_.cellOf(start, &start_col, &start_row)) return false;
   if (traversable_(start_row, start_col) == 0) {
@@ -140,11 +141,25 @@ bool GridPlanner::computeCostsFrom(const common::Point2& start) {
   const double resolution = map_.resolution;
   static constexpr int kDx[8] = {1, -1, 0, 0, 1, 1, -1, -1};
   static constexpr int kDy[8] = {0, 0, 1, -1, 1, -1, 1, -1};
+  const bool bounded = !targets.empty() && targets.size() == cost_.size();
+  double bound = kInfinity;  // the cheapest target reached plus margin
   while (!open.empty()) {
     const auto [cost, index] = open.top();
     open.pop();
     const int row = index / cols, col = index % cols;
     if (cost > cost_(row, col)) continue;
+    if (cost > bound) {  // every cell left costs more: forget what was queued beyond the bound
+      for (; !open.empty(); open.pop()) {
+        const int queued = open.top().second;
+        cost_(queued / cols, queued % cols) = kInfinity;
+        parent_(queued / cols, queued % cols) = -1;
+      }
+      cost_(row, col) = kInfinity;
+      parent_(row, col) = -1;
+      search_bounded_ = true;
+      break;
+    }
+    if (bounded && targets(row, col) != 0 && cost + margin < bound) bound = cost + margin;
     for (int k = 0; k < 8; ++k) {
       const int next_col = col + kDx[k], next_row = row + kDy[k];
       if (next_col < 0 || next_row < 0 || next_col >= cols || next_row >= rows) continue;

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include <geometry_msgs/Twist.h>
+#include <hidden_rooms/ExplorationStatus.h>
 #include <std_msgs/Bool.h>
 #include <visualization_msgs/MarkerArray.h>
 
@@ -71,6 +72,7 @@ Explorer::Explorer(ros::NodeHandle nh, const ExplorerOptions& options)
   command_publisher_ = nh.advertise<geometry_msgs::Twist>("cmd_vel", 1);
   done_publisher_ = nh.advertise<std_msgs::Bool>("exploration_done", 1, true);
   markers_publisher_ = nh.advertise<visualization_msgs::MarkerArray>("exploration_markers", 1, true);
+  status_publisher_ = nh.advertise<ExplorationStatus>("exploration_status", 1, true);
   std_msgs::Bool not_done;
   done_publisher_.publish(not_done);
   timer_ = nh.createTimer(ros::Duration(1.0 / options.control_rate), &Explorer::onTimer, this);
@@ -121,6 +123,7 @@ void Explorer::onResume(const std_msgs::Bool::ConstPtr& resume) {
     ROS_INFO("explorer: paused (true on %s resumes)", resume_subscriber_.getTopic().c_str());
   else
     ROS_INFO("explorer: resumed");
+  publishStatus(ros::Time::now());
 }
 
 bool Explorer::robotPose(common::Pose2* pose) {
@@ -192,7 +195,10 @@ void Explorer::onTimer(const ros::TimerEvent&) {
   }
   const exploration::ExplorationStep step = policy_.update(pose, now.toSec());
   report(step, now);
-  if (step.planned) publishMarkers(now);
+  if (step.planned) {
+    publishMarkers(now);
+    publishStatus(now);
+  }
   publishCommand(step.command);
 }
 
@@ -213,12 +219,15 @@ void Explorer::report(const exploration::ExplorationStep& step, const ros::Time&
         ROS_DEBUG("explorer: goal (%.2f, %.2f), path %.2f m, cost %.2f", x, y, event.path_length, event.cost);
         break;
       case exploration::ExplorationEventType::kGoalReached:
+        ++goals_reached_;
         break;
       case exploration::ExplorationEventType::kGoalFailedStuck:
+        ++goals_failed_;
         ROS_WARN("explorer: goal (%.2f, %.2f) failed: the robot did not move in %d recoveries (stuck?); "
                  "blacklisted until no other goal is left", x, y, event.recoveries);
         break;
       case exploration::ExplorationEventType::kGoalFailed:
+        ++goals_failed_;
         ROS_WARN("explorer: goal (%.2f, %.2f) not reached (%d recoveries, no progress); blacklisted (%s)", x, y,
                  event.recoveries,
                  event.retry_later ? "a second try when no other goal is left" : "it failed there on its second try");
@@ -267,6 +276,20 @@ void Explorer::publishCommand(const common::VelocityCommand& command) {
   if (stop && stopped_) return;  // one stop is enough (the simulator's watchdog also stops a silent robot)
   stopped_ = stop;
   command_publisher_.publish(toRos(command));
+}
+
+void Explorer::publishStatus(const ros::Time& now) {
+  ExplorationStatus status;
+  status.stamp = now;
+  status.paused = paused_;
+  status.done = policy_.done();
+  status.goals_chosen = static_cast<uint32_t>(goals_chosen_);
+  status.goals_reached = static_cast<uint32_t>(goals_reached_);
+  status.goals_failed = static_cast<uint32_t>(goals_failed_);
+  status.frontiers = static_cast<uint32_t>(policy_.frontiers().frontiers.size());
+  status.blacklisted = static_cast<uint32_t>(policy_.blacklist().points.size());
+  status.distance_driven = distance_driven_;
+  status_publisher_.publish(status);
 }
 
 void Explorer::publishMarkers(const ros::Time& now) {

@@ -124,6 +124,51 @@ TEST(Frontier, NearestGoalIsTheCheaperEndAndSkipsTheBlacklist) {
   EXPECT_LT(nearestFrontierGoal(frontiers, planner, Blacklist(), options, other->position, 100.0)->position.x(), 1.0);
 }
 
+// A search bounded by the goal candidates finds the goals of a full one (the nearest, the one the blacklist leaves,
+// a previous goal within the hysteresis) and stops short of the far end; its costs up to the bound are exact.
+TEST(Frontier, ASearchBoundedByTheCandidatesFindsTheSameGoals) {
+  const common::OccupancyGrid grid = corridorWithTwoEnds();
+  const FrontierMap frontiers = findFrontiers(grid);
+  const common::Point2 robot(7.0, 2.0);
+  const FrontierOptions options;
+  GridPlanner full, bounded;
+  full.setMap(grid);
+  bounded.setMap(grid);
+  ASSERT_TRUE(full.computeCostsFrom(robot));
+  EXPECT_FALSE(full.searchWasBounded());
+  Blacklist far_end;  // the right end blacklisted: the goal is the left one
+  far_end.radius = 3.0;
+  far_end.points.push_back(common::Point2(9.8, 2.0));
+  for (const Blacklist& blacklist : {Blacklist(), far_end}) {
+    for (double hysteresis : {0.0, 1.0, 100.0}) {
+      const cv::Mat1b targets = goalCandidates(frontiers, bounded, blacklist, options, robot, 0.5);
+      ASSERT_GT(cv::countNonZero(targets), 0);
+      ASSERT_TRUE(bounded.computeCostsFrom(robot, targets, hysteresis));
+      const common::Point2 left_goal(0.75, 2.05);
+      for (const std::optional<common::Point2>& previous : {std::optional<common::Point2>(), std::optional(left_goal)}) {
+        const auto expected = nearestFrontierGoal(frontiers, full, blacklist, options, previous, hysteresis);
+        const auto actual = nearestFrontierGoal(frontiers, bounded, blacklist, options, previous, hysteresis);
+        ASSERT_EQ(expected.has_value(), actual.has_value());
+        ASSERT_TRUE(actual.has_value());
+        EXPECT_EQ(actual->cell, expected->cell) << "hysteresis " << hysteresis;
+        EXPECT_DOUBLE_EQ(actual->cost, expected->cost);
+      }
+      int finite = 0;
+      for (int row = 0; row < grid.height(); ++row)
+        for (int col = 0; col < grid.width(); ++col)
+          if (std::isfinite(bounded.costTo(col, row))) {
+            ++finite;
+            EXPECT_DOUBLE_EQ(bounded.costTo(col, row), full.costTo(col, row));
+          }
+      if (blacklist.points.empty() && hysteresis == 0.0) {
+        EXPECT_TRUE(bounded.searchWasBounded());
+        EXPECT_FALSE(std::isfinite(bounded.costTo(5, 20))) << "the search went on to the far (left) end";
+      }
+      EXPECT_GT(finite, 0);
+    }
+  }
+}
+
 // The corridor with two frontier ends, searched from (7, 2), and a blacklist whose radius covers either end.
 class BlacklistRelease : public ::testing::Test {
  protected:

@@ -2,7 +2,7 @@
 """scripts/explore_worlds end to end on test/data/simulator_corridor.xml (a corridor with two rooms) with door 1
 closed: its own ROS master, simulator + mapper + explorer + pose_logger until the explorer is done, then the
 saved map, the door translated into the map frame, the true room, the prediction and the summary; short runs back to
-back, each starting its simulated time near 0; bad input; the wait for /use_sim_time (on a bare master); and the
+back, each starting its simulated time near 0 (its first pose within the 15 s the nodes take to start at 10x); bad input; the wait for /use_sim_time (on a bare master); and the
 no_growth rule and the progress status (these two without ROS).
 
 Needs the built package (found like the scripts find it: $CMAKE_PREFIX_PATH, else the checkout's .ws) and
@@ -226,12 +226,12 @@ class ExploreWorldsTest(unittest.TestCase):
             self.assertEqual(len(rows), len(worlds))
             for row in rows:
                 self.assertEqual(row["status"], "max_time", row)
-                self.assertTrue(6.0 <= float(row["sim_time_s"]) < 9.0, row)
+                self.assertTrue(6.0 <= float(row["sim_time_s"]) < 30.0, row)  # not an epoch; the last save runs on
                 poses = os.path.join(folder, "out", os.path.splitext(os.path.basename(row["world"]))[0],
                                      "poses_truth.log")
                 with open(poses) as poses_file:
                     first = next(line for line in poses_file if not line.startswith("#"))
-                self.assertLess(float(first.split()[0]), 3.0, "%s starts at %s" % (poses, first))
+                self.assertLess(float(first.split()[0]), 15.0, "%s starts at %s" % (poses, first))  # start-up at 10x
         finally:
             shutil.rmtree(folder, ignore_errors=True)
 

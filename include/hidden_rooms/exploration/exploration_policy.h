@@ -125,9 +125,11 @@ class ExplorationPolicy {
     bool start_reachable = false;
     bool new_map = false;
   };
-  static CostMap computeCostMap(const GridPlannerOptions& planner_options, const FrontierOptions& frontier_options,
-                                const std::vector<common::Point2>& blocked_points, double blocked_radius,
-                                const common::OccupancyGrid& map, const common::Point2& robot, bool new_map);
+  // The wavefront stops past the cheapest goal candidate plus goal_hysteresis (goalCandidates): the nearest goal
+  // and the kept one are the same as with costs everywhere.
+  static CostMap computeCostMap(const ExplorationPolicyOptions& options, const Blacklist& blacklist,
+                                const std::vector<common::Point2>& blocked_points, const common::OccupancyGrid& map,
+                                const common::Point2& robot, bool new_map);
   // Starts a plan from `pose` (in the background or in place): takes the pending map, if any.
   void plan(const common::Pose2& pose, double time, ExplorationStep* step);
   // Takes a finished cost map, chooses a goal and a path from `pose`, releasing blocked goals when none is left;

@@ -137,4 +137,11 @@ std::optional<FrontierGoal> nearestFrontierGoal(const FrontierMap& frontiers, co
                                                 const std::optional<common::Point2>& previous = std::nullopt,
                                                 double hysteresis = 1.0);
 
+// Cells that nearestFrontierGoal surely accepts as goals: roomy cells within options.goal_reach of a frontier cell,
+// not in `blacklist`, and at least options.min_goal_distance + `extra_distance` from `robot` (the search's start
+// cell may lie up to start_escape_radius from the robot). A search bounded by them (GridPlanner::computeCostsFrom
+// with the hysteresis as margin) gives nearestFrontierGoal the same goal as a full one.
+cv::Mat1b goalCandidates(const FrontierMap& frontiers, const GridPlanner& planner, const Blacklist& blacklist,
+                         const FrontierOptions& options, const common::Point2& robot, double extra_distance);
+
 }  // namespace hidden_rooms::exploration

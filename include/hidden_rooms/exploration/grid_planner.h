@@ -48,8 +48,11 @@ class GridPlanner {
   const common::OccupancyGrid& map() const { return map_; }
 
   // Costs from `start` (map frame) to every traversable cell. False (and nothing reachable) when the start lies
-  // outside the map or no traversable cell is within start_escape_radius of it.
-  bool computeCostsFrom(const common::Point2& start);
+  // outside the map or no traversable cell is within start_escape_radius of it. With `targets` (255 on the cells a
+  // search is for; the map's size), the search stops once every cell left costs more than the cheapest target
+  // reached plus `margin`: the costs up to that bound are exact, those beyond it stay infinite (the whole map when
+  // no target is reachable).
+  bool computeCostsFrom(const common::Point2& start, const cv::Mat1b& targets = cv::Mat1b(), double margin = 0.0);
 
   // Path cost (metres weighted by proximity) from the last start to the cell; +infinity when unreachable or
   // outside the grid.
@@ -61,6 +64,8 @@ class GridPlanner {
   const cv::Mat1b& roomy() const { return roomy_; }
   // Distance (metres) from each cell to the nearest obstacle cell.
   const cv::Mat1f& obstacleDistance() const { return obstacle_distance_; }
+  // The last search stopped at its targets' bound (some reachable cells were left at infinite cost).
+  bool searchWasBounded() const { return search_bounded_; }
   // Cell where the last search started (the start or the cell it escaped to); (-1, -1) before any.
   cv::Point startCell() const { return start_cell_; }
 
@@ -79,6 +84,7 @@ class GridPlanner {
   cv::Mat1d cost_;         // path cost from the start (infinity where unreachable)
   cv::Mat1i parent_;       // index (row * width + col) of the predecessor, -1 at the start / unreached
   cv::Point start_cell_{-1, -1};
+  bool search_bounded_ = false;
   std::vector<common::Point2> blocked_points_;
   double blocked_radius_ = 0.0;
 };

@@ -38,7 +38,7 @@ ExplorerOptions readExplorerOptions(const ros::NodeHandle& private_nh);
 
 // Nearest-frontier exploration (replaces explore + move_base) with the core's ExplorationPolicy on the latest
 // `map`, the robot's pose from tf and the laser on `base_scan`: publishes its commands on `cmd_vel`, its state on
-// `exploration_markers` and the latched `exploration_done`, and logs its events. Stops (and holds the policy)
+// `exploration_markers`, the latched `exploration_done` and `exploration_status`, and logs its events. Stops (and holds the policy)
 // while the map, the pose or the scan is stale, and while paused: false on `~resume` (std_msgs/Bool, as
 // explore_lite's resume topic) pauses, true resumes with the same goal and blacklist.
 class Explorer {
@@ -60,6 +60,7 @@ class Explorer {
   void report(const exploration::ExplorationStep& step, const ros::Time& now);
   void publishCommand(const common::VelocityCommand& command);
   void publishMarkers(const ros::Time& now);
+  void publishStatus(const ros::Time& now);
 
   ExplorerOptions options_;
   exploration::ExplorationPolicy policy_;
@@ -77,12 +78,15 @@ class Explorer {
   std::optional<common::Pose2> last_pose_;
   double distance_driven_ = 0.0;
   int goals_chosen_ = 0;
+  int goals_reached_ = 0;
+  int goals_failed_ = 0;
   ros::Subscriber map_subscriber_;
   ros::Subscriber scan_subscriber_;
   ros::Subscriber resume_subscriber_;
   ros::Publisher command_publisher_;
   ros::Publisher done_publisher_;
   ros::Publisher markers_publisher_;
+  ros::Publisher status_publisher_;
   ros::Timer timer_;
 };
 
