@@ -183,16 +183,21 @@ def write_markdown_table(path, tables, methods, environments):
             stream.write("|" + "---|" * (3 + 2 * len(methods)) + "\n")
             for entry in table:
                 closed = "**all**" if entry["closed_doors"] == ALL else str(entry["closed_doors"])
-                best = best_methods(entry, methods)
-                cells = []
-                for m in methods:
-                    mean = "%.3f" % entry["iou_" + m]
-                    cells.append("%s ± %s" % ("**%s**" % mean if m in best else mean,
-                                              half_width_text(entry, m, "%.3f")))
+                cells = iou_cells(entry, methods, "**%s**", "±")
                 stream.write("| %s | %d | %.2f | " % (closed, entry["cases"], entry["hidden_percent"]) +
                              " | ".join(cells) + " | " +
                              " | ".join("%.3f" % entry["iou_tot_" + m] for m in methods) + " |\n")
             stream.write("\n")
+
+
+def iou_cells(entry, methods, bold, plus_minus):
+    """Per method, "mean PLUS_MINUS half-width" of the table entry's IoU, the best methods' mean formatted by `bold`."""
+    best = best_methods(entry, methods)
+    cells = []
+    for m in methods:
+        mean = "%.3f" % entry["iou_" + m]
+        cells.append("%s %s %s" % (bold % mean if m in best else mean, plus_minus, half_width_text(entry, m, "%.3f")))
+    return cells
 
 
 def latex_escape(text):
@@ -215,12 +220,7 @@ def write_latex_table(path, tables, methods, environments):
         for entry in table:
             if entry["closed_doors"] == ALL:
                 lines.append("\\addlinespace[2pt]")
-            best = best_methods(entry, methods)
-            cells = []
-            for m in methods:
-                mean = "%.3f" % entry["iou_" + m]
-                cells.append("%s $\\pm$ %s" % ("\\textbf{%s}" % mean if m in best else mean,
-                                               half_width_text(entry, m, "%.3f")))
+            cells = iou_cells(entry, methods, "\\textbf{%s}", "$\\pm$")
             lines.append("%s & %d & %.1f & %s \\\\" % (entry["closed_doors"], entry["cases"], entry["hidden_percent"],
                                                       " & ".join(cells)))
     lines += ["\\bottomrule", "\\end{tabular}"]
