@@ -95,6 +95,7 @@ ExplorationStep ExplorationPolicy::update(const common::Pose2& pose, double time
       step.command = follower_.update(pose, obstacles, time).command;
       return step;
     }
+    goal_ended_ = background_plan_.valid();
   }
   if (goal_ended_) return step;  // stand still until the plan for the next goal is in
   // No goal: turn in place to look around until a frontier shows up or done is confirmed.
@@ -148,10 +149,7 @@ ExplorationPolicy::CostMap ExplorationPolicy::computeCostMap(const ExplorationPo
 }
 
 void ExplorationPolicy::plan(const common::Pose2& pose, double time, ExplorationStep* step) {
-  if (background_plan_.valid()) {  // one at a time: a goal that ended waits for the running plan
-    goal_ended_ = goal_ended_ || !goal_;
-    return;
-  }
+  if (background_plan_.valid()) return;  // one at a time
   last_plan_ = time;
   const PendingMap pending = pending_map_;
   pending_map_ = PendingMap::kNone;
@@ -169,7 +167,6 @@ void ExplorationPolicy::plan(const common::Pose2& pose, double time, Exploration
     choose(computeCostMap(options_, blacklist_, passages_.blockedPoints(), map, robot, new_map), pose, time, step);
     return;
   }
-  goal_ended_ = !goal_;
   background_plan_ = std::async(std::launch::async, &ExplorationPolicy::computeCostMap, options_, blacklist_,
                                 passages_.blockedPoints(), map, robot, new_map);
 }

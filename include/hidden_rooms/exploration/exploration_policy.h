@@ -86,7 +86,8 @@ struct ExplorationStep {
 // plans on new maps in a row without a goal; until then, and without a goal, it turns in place. Times are seconds
 // of a monotonic clock (the node uses ROS time); differences within half a nanosecond count as equal. With
 // background_planning, a plan started at one update is used at the first update after it finished (the robot
-// keeps following its path meanwhile, and stands still when its goal ended); one plan runs at a time.
+// keeps following its path meanwhile, stands still when its goal ended, and turns in place when it had none);
+// one plan runs at a time.
 class ExplorationPolicy {
  public:
   explicit ExplorationPolicy(const ExplorationPolicyOptions& options = ExplorationPolicyOptions());
