@@ -248,15 +248,22 @@ class Run:
         return free_cells
 
 
-def wait_for_master(launch, deadline):
-    import rosgraph
+def wait_for_launch(launch, deadline, ready, event):
+    """Polls `ready()` every 0.1 s until it is true. RuntimeError naming `event` (what `ready` waits for, e.g. "the
+    master came up") when roslaunch exits first or at `deadline` (time.monotonic())."""
+    started = time.monotonic()
     while time.monotonic() < deadline:
         if launch.poll() is not None:
-            raise RuntimeError("roslaunch exited with code %d before the master came up" % launch.returncode)
-        if rosgraph.Master("/explore_worlds").is_online():
+            raise RuntimeError("roslaunch exited with code %d before %s" % (launch.returncode, event))
+        if ready():
             return
-        time.sleep(0.5)
-    raise RuntimeError("no ROS master after %.0f s" % MASTER_START_TIMEOUT)
+        time.sleep(0.1)
+    raise RuntimeError("timed out after %.1f s waiting until %s" % (time.monotonic() - started, event))
+
+
+def wait_for_master(launch, deadline):
+    import rosgraph
+    wait_for_launch(launch, deadline, rosgraph.Master("/explore_worlds").is_online, "the master came up")
 
 
 def wait_for_simulated_time(launch, deadline):
@@ -265,16 +272,14 @@ def wait_for_simulated_time(launch, deadline):
     once with max_time, its simulated time an epoch)."""
     import rosgraph
     master = rosgraph.Master("/explore_worlds")
-    while time.monotonic() < deadline:
-        if launch.poll() is not None:
-            raise RuntimeError("roslaunch exited with code %d before it set /use_sim_time" % launch.returncode)
+
+    def use_sim_time():
         try:
-            if master.getParam("/use_sim_time") is True:
-                return
+            return master.getParam("/use_sim_time") is True
         except (rosgraph.MasterException, OSError):
-            pass  # not set yet
-        time.sleep(0.1)
-    raise RuntimeError("/use_sim_time not set %.0f s after the master came up" % MASTER_START_TIMEOUT)
+            return False  # not set yet
+
+    wait_for_launch(launch, deadline, use_sim_time, "it set /use_sim_time")
 
 
 def stop_launch(launch):
