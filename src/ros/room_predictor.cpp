@@ -177,6 +177,8 @@ void RoomPredictorNode::reconfigure(RoomPredictorConfig& config, uint32_t) {
     // The method or a parameter value refused; other problems (the map, the doors) are not the settings'.
     if (error.source() == "method" || error.source().rfind("parameter", 0) == 0) refused = error.what();
     else ROS_WARN("room_predictor: reconfigured, but the prediction failed: %s", error.what());
+  } catch (const std::exception& error) {  // a bug, reported as predictRooms reports it, not a crash of the node
+    ROS_WARN("room_predictor: reconfigured, but the prediction failed: %s", error.what());
   }
   if (!refused.empty()) {
     ROS_WARN("room_predictor: settings not applied: %s", refused.c_str());
