@@ -21,16 +21,16 @@ using Type = ExplorationEventType;
 // A known corridor 8 m x 3 m (0.1 m cells; free x 1.0..9.0, y 0.1..3.1, walls along both long sides) between
 // unknown ends (x < 1.0 and x > 9.0); an end that is not open has a wall (no frontier there). Goals on the
 // frontiers' side of the robot lie 0.5 m inside the corridor (goal_reach 0.6 m is 5 whole cells): x = 1.55 and
-// 8.45.
-common::OccupancyGrid corridor(bool left_open, bool right_open) {
+// 8.45. Another size (`cols` x `rows` cells) keeps the 1 m unknown ends and the walls.
+common::OccupancyGrid corridor(bool left_open, bool right_open, int cols = 100, int rows = 32) {
   common::OccupancyGrid grid;
   grid.resolution = 0.1;
-  grid.cells = cv::Mat_<int8_t>(32, 100, common::OccupancyGrid::kUnknown);
-  grid.cells(cv::Rect(0, 0, 100, 1)).setTo(common::OccupancyGrid::kOccupied);
-  grid.cells(cv::Rect(0, 31, 100, 1)).setTo(common::OccupancyGrid::kOccupied);
-  grid.cells(cv::Rect(10, 1, 80, 30)).setTo(common::OccupancyGrid::kFree);
-  if (!left_open) grid.cells(cv::Rect(9, 1, 1, 30)).setTo(common::OccupancyGrid::kOccupied);
-  if (!right_open) grid.cells(cv::Rect(90, 1, 1, 30)).setTo(common::OccupancyGrid::kOccupied);
+  grid.cells = cv::Mat_<int8_t>(rows, cols, common::OccupancyGrid::kUnknown);
+  grid.cells(cv::Rect(0, 0, cols, 1)).setTo(common::OccupancyGrid::kOccupied);
+  grid.cells(cv::Rect(0, rows - 1, cols, 1)).setTo(common::OccupancyGrid::kOccupied);
+  grid.cells(cv::Rect(10, 1, cols - 20, rows - 2)).setTo(common::OccupancyGrid::kFree);
+  if (!left_open) grid.cells(cv::Rect(9, 1, 1, rows - 2)).setTo(common::OccupancyGrid::kOccupied);
+  if (!right_open) grid.cells(cv::Rect(cols - 10, 1, 1, rows - 2)).setTo(common::OccupancyGrid::kOccupied);
   return grid;
 }
 
@@ -158,14 +158,7 @@ TEST(ExplorationPolicy, ABackgroundPlanDoesNotHoldUpTheControlLoop) {
   EXPECT_NEAR(first(step, Type::kGoalChosen).position.x(), kRightGoalX, 1e-9);
   EXPECT_GT(step.command.linear, 0.0);
 
-  common::OccupancyGrid large;
-  large.resolution = 0.1;
-  large.cells = cv::Mat_<int8_t>(2000, 2000, common::OccupancyGrid::kFree);
-  large.cells(cv::Rect(0, 0, 2000, 1)).setTo(common::OccupancyGrid::kOccupied);
-  large.cells(cv::Rect(0, 1999, 2000, 1)).setTo(common::OccupancyGrid::kOccupied);
-  large.cells(cv::Rect(0, 0, 1, 2000)).setTo(common::OccupancyGrid::kOccupied);
-  large.cells(cv::Rect(1990, 1, 10, 1998)).setTo(common::OccupancyGrid::kUnknown);  // the frontier, 199 m away
-  policy.setMap(large);
+  policy.setMap(corridor(false, true, 2000, 2000));  // 198 m x 200 m, the frontier 194 m away
   int moving_while_planning = 0;
   step = ExplorationStep();
   for (int k = 0; k < 100000 && !step.planned; ++k) {  // about real time: 1 ms a step

@@ -38,9 +38,9 @@ ExplorerOptions readExplorerOptions(const ros::NodeHandle& private_nh);
 
 // Nearest-frontier exploration (replaces explore + move_base) with the core's ExplorationPolicy on the latest
 // `map`, the robot's pose from tf and the laser on `base_scan`: publishes its commands on `cmd_vel`, its state on
-// `exploration_markers`, the latched `exploration_done` and `exploration_status`, and logs its events. Stops (and holds the policy)
-// while the map, the pose or the scan is stale, and while paused: false on `~resume` (std_msgs/Bool, as
-// explore_lite's resume topic) pauses, true resumes with the same goal and blacklist.
+// `exploration_markers`, the latched `exploration_done` and `exploration_status`, and logs its events. Stops (and
+// holds the policy) while the map, the pose or the scan is stale, and while paused: false on `~resume`
+// (std_msgs/Bool, as explore_lite's resume topic) pauses, true resumes with the same goal and blacklist.
 class Explorer {
  public:
   // Subscribes and advertises; does not wait for anything (the control timer does the work).
