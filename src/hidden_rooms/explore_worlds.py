@@ -308,7 +308,7 @@ class GrowthStop:
 
 
 def explore(args, out_dir, log):
-    """Runs the launch until a stop criterion; returns (status, simulated seconds). Maps go to out_dir."""
+    """Runs the launch until a stop criterion; returns (status, the simulated time its stop rule fired at). Maps go to out_dir."""
     maps_dir = os.path.join(out_dir, "maps")
     os.makedirs(maps_dir, exist_ok=True)
     # The pose_logger continues existing logs (it is respawned with append): those of an earlier, unfinished run go.
@@ -358,9 +358,11 @@ def explore(args, out_dir, log):
                 if growth_stop.update(free):
                     status = "no_growth"
                 next_save += args.timeout
-        write_progress(out_dir, "finishing", run.sim_time(), run.free_area, run.goals, saved, status)
+        # The run's simulated time is when its stop rule fired: the simulation goes on while the last map is saved
+        # and roslaunch stops (seconds of simulated time at 10x on a busy machine).
+        write_progress(out_dir, "finishing", now, run.free_area, run.goals, saved, status)
         run.save_map(os.path.join(out_dir, "map"))
-        return status, run.sim_time()
+        return status, now
     finally:
         stop_launch(launch)
 
