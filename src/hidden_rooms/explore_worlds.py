@@ -52,6 +52,7 @@ STALL_TIMEOUT = 60.0          # wall seconds without simulated time advancing: t
 SHUTDOWN_TIMEOUT = 20.0       # wall seconds for roslaunch to stop after SIGINT
 WALL_CLOCK_EPOCH = 1e8         # seconds: no simulated run gets this far; wall-clock time (since 1970) is beyond
 PROGRESS_INTERVAL = 1.0       # wall seconds between two writes of progress.json (worker) and two bar updates
+LOCKSTEP_CHECK = 1.0          # simulated seconds between the stop rules' checks in lockstep (--realtime-factor 0)
 
 
 def die_with_parent():
@@ -217,6 +218,7 @@ class Run:
         self.done = False
         self.free_area = None  # m², of the last saved map
         self.goals = None
+        self._run_until = None
         rospy.Subscriber("exploration_done", Bool, self._on_done, queue_size=1)
         rospy.Subscriber("exploration_status", ExplorationStatus, self._on_status, queue_size=1)
 
@@ -228,6 +230,17 @@ class Run:
 
     def sim_time(self):
         return self.rospy.get_time()
+
+    def run_until(self, sim_time):
+        """Asks the simulator to hold its clock at `sim_time`; returns its answer (reached, now, finished)."""
+        from hidden_rooms.srv import RunUntil
+        if self._run_until is None:
+            self._run_until = self.rospy.ServiceProxy("run_until", RunUntil, persistent=True)
+            self._run_until.wait_for_service(timeout=30.0)
+        response = self._run_until(time=sim_time)
+        if not response.success:
+            raise RuntimeError("run_until: %s" % response.message)
+        return response
 
     def save_map(self, prefix):
         """Writes PREFIX.yaml/.pgm through the mapper's save_map; returns the number of free cells of the map."""
@@ -319,6 +332,8 @@ def explore(args, out_dir, log):
                "exploration_run.launch", "world:=%s" % args.world, "out_dir:=%s" % out_dir,
                "closed_doors:=%s" % args.closed, "realtime_factor:=%g" % args.realtime_factor,
                "seed:=%d" % args.seed, "gui:=%s" % ("true" if args.gui else "false")]
+    if args.realtime_factor == 0:
+        command.append("run_until:=%g" % LOCKSTEP_CHECK)  # held there until the loop below asks for more
     if args.bag:
         command.append("bag:=%s" % os.path.join(out_dir, "run.bag"))
     launch = subprocess.Popen(command, stdout=log, stderr=subprocess.STDOUT, start_new_session=True,
@@ -335,12 +350,27 @@ def explore(args, out_dir, log):
         next_save = args.timeout
         last_sim, last_progress = 0.0, time.monotonic()
         last_written = 0.0
+        lockstep = args.realtime_factor == 0
         while status is None:
-            time.sleep(0.05)  # 0.5 s of simulated time at 10x
             if launch.poll() is not None:
                 raise RuntimeError("roslaunch exited with code %d during the run (see %s)"
                                    % (launch.returncode, log.name))
-            now = run.sim_time()
+            if lockstep:
+                # The simulator holds at each check time until the mapper and the explorer have handled its scan,
+                # so the stop rules and saved maps see the same state on every run of a seed.
+                target = min(next_save, args.max_time, (round(last_sim / LOCKSTEP_CHECK) + 1) * LOCKSTEP_CHECK)
+                answer = run.run_until(target)
+                while not answer.reached:
+                    time.sleep(0.005)
+                    if launch.poll() is not None or time.monotonic() - last_progress > STALL_TIMEOUT:
+                        break
+                    answer = run.run_until(target)
+                now = answer.now if answer.reached else run.sim_time()
+                done = "/explorer" in answer.finished
+            else:
+                time.sleep(0.05)  # 0.5 s of simulated time at 10x
+                now = run.sim_time()
+                done = run.done
             if time.monotonic() - last_written >= PROGRESS_INTERVAL:
                 write_progress(out_dir, "exploring", now, run.free_area, run.goals, saved)
                 last_written = time.monotonic()
@@ -348,7 +378,7 @@ def explore(args, out_dir, log):
                 last_sim, last_progress = now, time.monotonic()
             elif time.monotonic() - last_progress > STALL_TIMEOUT:
                 raise RuntimeError("simulated time stopped at %.1f s" % now)
-            if run.done:
+            if done:
                 status = "done"
             elif now >= args.max_time:
                 status = "max_time"
@@ -485,7 +515,9 @@ def parse_arguments(argv):
     parser.add_argument("--max-time", type=float, default=1800.0, help="simulated seconds at most per world")
     parser.add_argument("--realtime-factor", type=float, default=10.0,
                         help="simulated seconds per wall second (at 10 the explorer, planning in the background, and "
-                             "the mapper keep up on 2 cores)")
+                             "the mapper keep up on 2 cores); 0 = lockstep: the simulator steps on when the mapper "
+                             "and the explorer have handled each scan, as fast as the machine allows, and a seed "
+                             "gives the same run every time")
     parser.add_argument("--seed", type=int, default=0, help="seed of the simulator and the filter")
     parser.add_argument("--jobs", type=int, default=1, help="worlds explored side by side")
     parser.add_argument("--method", default="default", help="prediction method on the explored map ('' = none)")
@@ -496,9 +528,11 @@ def parse_arguments(argv):
                              "simulated time, mapped area, goals, saved maps)")
     parser.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
-    for name in ("timeout", "max_time", "realtime_factor"):
+    for name in ("timeout", "max_time"):
         if not getattr(args, name) > 0:
             parser.error("--%s must be positive" % name.replace("_", "-"))
+    if not args.realtime_factor >= 0:
+        parser.error("--realtime-factor must be positive, or 0 for lockstep")
     if args.patience < 1:
         parser.error("--patience must be at least 1")
     if args.jobs < 1:

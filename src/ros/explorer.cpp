@@ -28,6 +28,11 @@ const common::OptionTable<ExplorerOptions>& explorerNodeOptionTable() {
       {"start_paused", &O::start_paused, "wait for true on ~resume before exploring"},
       {"background_planning", static_cast<bool O::*>(&O::background_planning),
        "plan on a thread of its own while the robot follows its path; false = in the control loop (deterministic)"},
+      {"lockstep_mapper", &O::lockstep_mapper,
+       "lockstep: the mapper node whose reports the steps follow (one per scan); \"\" = free-running"},
+      {"odom_frame", &O::odom_frame, "lockstep: the odometry frame (map -> odom -> base)", common::anyFinite(), true},
+      {"lockstep_wait", &O::lockstep_wait, "lockstep: wall seconds a step waits for the mapper's results",
+       common::above(0)},
   };
   return table;
 }
@@ -59,12 +64,14 @@ ExplorerOptions readExplorerOptions(const ros::NodeHandle& nh) {
   readParameters(nh, exploration::explorationPolicyOptionTable(),
                  static_cast<exploration::ExplorationPolicyOptions*>(&options));
   readParameters(nh, explorerNodeOptionTable(), &options);
+  if (!options.lockstep_mapper.empty()) options.background_planning = false;  // a plan's length must not matter
   return options;
 }
 
 Explorer::Explorer(ros::NodeHandle nh, const ExplorerOptions& options)
     : options_(options), policy_(options), tf_buffer_(ros::Duration(10.0)), tf_listener_(tf_buffer_) {
-  map_subscriber_ = nh.subscribe("map", 1, &Explorer::onMap, this);
+  // In lockstep a map waits for its step, and the mapper may publish the next one meanwhile: none may be dropped.
+  map_subscriber_ = nh.subscribe("map", options.lockstep_mapper.empty() ? 1 : 2, &Explorer::onMap, this);
   scan_subscriber_ = nh.subscribe("scan", 1, &Explorer::onScan, this);
   resume_subscriber_ = ros::NodeHandle("~").subscribe("resume", 10, &Explorer::onResume, this);
   paused_ = options.start_paused;
@@ -75,7 +82,18 @@ Explorer::Explorer(ros::NodeHandle nh, const ExplorerOptions& options)
   status_publisher_ = nh.advertise<ExplorationStatus>("exploration_status", 1, true);
   std_msgs::Bool not_done;
   done_publisher_.publish(not_done);
-  timer_ = nh.createTimer(ros::Duration(1.0 / options.control_rate), &Explorer::onTimer, this);
+  if (options.lockstep_mapper.empty()) {
+    timer_ = nh.createTimer(ros::Duration(1.0 / options.control_rate), &Explorer::onTimer, this);
+  } else {
+    std::string problem;
+    if (!ros::names::validate(options.lockstep_mapper, problem))
+      throw common::InputError("~lockstep_mapper", "'" + options.lockstep_mapper + "' is not a node name: " + problem);
+    lockstep_mapper_ = ros::names::resolve(options.lockstep_mapper);
+    lockstep_publisher_ = nh.advertise<hidden_rooms::LockstepAck>("lockstep", 10, true);
+    lockstep_subscriber_ = nh.subscribe("lockstep", 100, &Explorer::onLockstepAck, this);
+    reportLockstep(ros::Time());  // ready
+    ROS_INFO("explorer: lockstep: one step per scan, after %s's report of the scan before", lockstep_mapper_.c_str());
+  }
 }
 
 void Explorer::onMap(const nav_msgs::OccupancyGrid::ConstPtr& map) {
@@ -83,8 +101,17 @@ void Explorer::onMap(const nav_msgs::OccupancyGrid::ConstPtr& map) {
     ROS_WARN_THROTTLE(5.0, "explorer: empty map received; ignored");
     return;
   }
+  if (lockstep_mapper_.empty()) {
+    applyMap(map, ros::Time::now());
+    return;
+  }
+  pending_maps_.push_back(map);
+  tryLockstepStep();
+}
+
+void Explorer::applyMap(const nav_msgs::OccupancyGrid::ConstPtr& map, const ros::Time& received) {
   latest_map_ = map;
-  map_received_ = ros::Time::now();
+  map_received_ = received;
   try {
     policy_.setMap(fromRos(*map));
   } catch (const common::InputError& error) {
@@ -93,6 +120,16 @@ void Explorer::onMap(const nav_msgs::OccupancyGrid::ConstPtr& map) {
 }
 
 void Explorer::onScan(const sensor_msgs::LaserScan::ConstPtr& scan) {
+  if (!lockstep_mapper_.empty()) {
+    if (scan->header.stamp == last_step_stamp_) {  // the simulator re-sent a scan already stepped
+      reportLockstep(last_step_stamp_);
+      return;
+    }
+    if (pending_scan_ && scan->header.stamp == pending_scan_->header.stamp) {  // re-sent while its step waits
+      tryLockstepStep();
+      return;
+    }
+  }
   LaserMount mount;
   try {
     mount = laserMountFromRos(tf_buffer_.lookupTransform(options_.base_frame, scan->header.frame_id, ros::Time(0)).transform);
@@ -114,6 +151,55 @@ void Explorer::onScan(const sensor_msgs::LaserScan::ConstPtr& scan) {
   } catch (const common::InputError& error) {
     ROS_WARN_THROTTLE(5.0, "explorer: bad scan: %s", error.what());
   }
+  if (!lockstep_mapper_.empty()) {
+    pending_scan_ = scan;
+    pending_since_ = ros::WallTime::now();
+    tryLockstepStep();
+  }
+}
+
+void Explorer::onLockstepAck(const hidden_rooms::LockstepAck::ConstPtr& ack) {
+  if (ack->node != lockstep_mapper_) return;
+  if (!mapper_acks_.empty() && ack->stamp <= mapper_acks_.back().stamp) return;  // re-sent
+  mapper_acks_.push_back(*ack);
+  tryLockstepStep();
+}
+
+void Explorer::tryLockstepStep() {
+  if (!pending_scan_) return;
+  const ros::Time stamp = pending_scan_->header.stamp;
+  // The mapper's report of the scan before this one (none before the first step): it handles this one meanwhile.
+  while (!mapper_acks_.empty() && mapper_acks_.front().stamp < last_step_stamp_) mapper_acks_.pop_front();
+  const bool first = last_step_stamp_.isZero();
+  const bool reported = first || (!mapper_acks_.empty() && mapper_acks_.front().stamp == last_step_stamp_);
+  const ros::Time map_stamp = reported && !first ? mapper_acks_.front().map_stamp : ros::Time();
+  const bool map_here = map_stamp.isZero() || (latest_map_ && latest_map_->header.stamp >= map_stamp) ||
+                        (!pending_maps_.empty() && pending_maps_.back()->header.stamp >= map_stamp);
+  if (!(reported && map_here)) {
+    if ((ros::WallTime::now() - pending_since_).toSec() < options_.lockstep_wait) return;  // a later callback retries
+    ROS_WARN_THROTTLE(5.0, "explorer: lockstep: %s from %s for the scan at %.2f s after %.1f s (wall); stepping "
+                      "with what is here", reported ? "no map" : "no report", lockstep_mapper_.c_str(),
+                      last_step_stamp_.toSec(), options_.lockstep_wait);
+  }
+  // The newest map up to the reported one (maps the mapper published later wait for their step).
+  while (!pending_maps_.empty() && (map_stamp.isZero() ? !reported : pending_maps_.front()->header.stamp <= map_stamp)) {
+    applyMap(pending_maps_.front(), stamp);
+    pending_maps_.pop_front();
+  }
+  transform_stamp_ = reported && !first ? mapper_acks_.front().transform_stamp : ros::Time();
+  pending_scan_.reset();
+  controlStep(stamp);
+  last_step_stamp_ = stamp;
+  reportLockstep(stamp);
+}
+
+void Explorer::reportLockstep(const ros::Time& stamp) {
+  hidden_rooms::LockstepAck ack;
+  ack.node = ros::this_node::getName();
+  ack.stamp = stamp;
+  ack.commands = commands_published_;
+  ack.finished = policy_.done();
+  lockstep_publisher_.publish(ack);
 }
 
 void Explorer::onResume(const std_msgs::Bool::ConstPtr& resume) {
@@ -126,16 +212,28 @@ void Explorer::onResume(const std_msgs::Bool::ConstPtr& resume) {
   publishStatus(ros::Time::now());
 }
 
-bool Explorer::robotPose(common::Pose2* pose) {
+bool Explorer::robotPose(const ros::Time& now, common::Pose2* pose) {
   try {
-    const geometry_msgs::TransformStamped transform =
-        tf_buffer_.lookupTransform(options_.map_frame, options_.base_frame, ros::Time(0));
-    if ((ros::Time::now() - transform.header.stamp).toSec() > options_.pose_timeout) {
-      ROS_WARN_THROTTLE(5.0, "explorer: %s -> %s is %.1f s old; stopped", options_.map_frame.c_str(),
-                        options_.base_frame.c_str(), (ros::Time::now() - transform.header.stamp).toSec());
-      return false;
+    if (lockstep_mapper_.empty()) {
+      const geometry_msgs::TransformStamped transform =
+          tf_buffer_.lookupTransform(options_.map_frame, options_.base_frame, ros::Time(0));
+      if ((now - transform.header.stamp).toSec() > options_.pose_timeout) {
+        ROS_WARN_THROTTLE(5.0, "explorer: %s -> %s is %.1f s old; stopped", options_.map_frame.c_str(),
+                          options_.base_frame.c_str(), (now - transform.header.stamp).toSec());
+        return false;
+      }
+      *pose = fromRos(transform.transform);
+      return true;
     }
-    *pose = fromRos(transform.transform);
+    // Lockstep: map -> odom as the mapper reported it, odom -> base at the scan's stamp (tf's thread brings them;
+    // tf2's own timeout runs on ROS time, which stands still here).
+    if (transform_stamp_.isZero()) throw tf2::LookupException("the mapper has reported no map -> odom yet");
+    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(options_.lockstep_wait);
+    while (!tf_buffer_.canTransform(options_.map_frame, transform_stamp_, options_.base_frame, now,
+                                    options_.odom_frame) && ros::WallTime::now() < deadline && ros::ok())
+      ros::WallDuration(0.0005).sleep();
+    *pose = fromRos(tf_buffer_.lookupTransform(options_.map_frame, transform_stamp_, options_.base_frame, now,
+                                               options_.odom_frame).transform);
     return true;
   } catch (const tf2::TransformException& error) {
     ROS_WARN_THROTTLE(5.0, "explorer: waiting for %s -> %s: %s", options_.map_frame.c_str(), options_.base_frame.c_str(),
@@ -149,8 +247,9 @@ void Explorer::holdRobot(const ros::Time& now) {
   publishCommand(common::VelocityCommand());
 }
 
-void Explorer::onTimer(const ros::TimerEvent&) {
-  const ros::Time now = ros::Time::now();
+void Explorer::onTimer(const ros::TimerEvent&) { controlStep(ros::Time::now()); }
+
+void Explorer::controlStep(const ros::Time& now) {
   if (!latest_map_) {
     ROS_INFO_THROTTLE(10.0, "explorer: waiting for a map on %s", map_subscriber_.getTopic().c_str());
     return;
@@ -160,7 +259,7 @@ void Explorer::onTimer(const ros::TimerEvent&) {
     return;
   }
   common::Pose2 pose;
-  if (!robotPose(&pose)) {
+  if (!robotPose(now, &pose)) {
     holdRobot(now);
     return;
   }
@@ -276,6 +375,7 @@ void Explorer::publishCommand(const common::VelocityCommand& command) {
   if (stop && stopped_) return;  // one stop is enough (the simulator's watchdog also stops a silent robot)
   stopped_ = stop;
   command_publisher_.publish(toRos(command));
+  ++commands_published_;
 }
 
 void Explorer::publishStatus(const ros::Time& now) {

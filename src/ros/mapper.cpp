@@ -27,6 +27,8 @@ const common::OptionTable<MapperOptions>& mapperNodeOptionTable() {
       {"future_stamp_tolerance", &O::future_stamp_tolerance,
        "seconds a scan may be stamped ahead of ROS time; 0 = no check", common::atLeast(0)},
       {"publish_particles", &O::publish_particles, "publish particles"},
+      {"lockstep", &O::lockstep, "report each scan on `lockstep` (the simulator's ~lockstep_nodes)"},
+      {"tf_wait_wall", &O::tf_wait_wall, "wall seconds a scan waits for its odometry in lockstep", common::above(0)},
   };
   return table;
 }
@@ -50,6 +52,7 @@ MapperOptions readMapperOptions(const ros::NodeHandle& nh) {
   if (options.rbpf.config_file.empty())
     throw common::InputError("~config_file", "must name the MRPT ini (config/rbpf.ini)");
   readParameters(nh, mapperNodeOptionTable(), &options);
+  if (options.lockstep) options.tf_publish_rate = 0.0;  // a timer's stamps would depend on the machine's speed
   return options;
 }
 
@@ -64,6 +67,10 @@ Mapper::Mapper(ros::NodeHandle nh, const MapperOptions& options)
   if (options.publish_particles) particles_publisher_ = nh.advertise<geometry_msgs::PoseArray>("particles", 1);
   save_service_ = nh.advertiseService("save_map", &Mapper::onSaveMap, this);
   dynamic_map_service_ = nh.advertiseService("dynamic_map", &Mapper::onDynamicMap, this);
+  if (options.lockstep) {
+    lockstep_publisher_ = nh.advertise<hidden_rooms::LockstepAck>("lockstep", 10, true);
+    reportLockstep(ros::Time());  // ready
+  }
   if (options.tf_publish_rate > 0.0) {
     ros::NodeHandle tf_nh(nh);
     tf_nh.setCallbackQueue(&tf_queue_);
@@ -78,6 +85,15 @@ Mapper::Mapper(ros::NodeHandle nh, const MapperOptions& options)
 // later scan look old), and scans without a valid range (NaN, infinite, out of range: nothing to match or insert,
 // and the filter would spend an update and an insertion on them).
 void Mapper::onScan(const sensor_msgs::LaserScan::ConstPtr& scan) {
+  if (options_.lockstep && !last_scan_stamp_.isZero() && scan->header.stamp == last_scan_stamp_) {
+    reportLockstep(last_scan_stamp_);  // the simulator re-sent a scan: handled already
+    return;
+  }
+  handleScan(scan);
+  if (options_.lockstep) reportLockstep(scan->header.stamp);
+}
+
+void Mapper::handleScan(const sensor_msgs::LaserScan::ConstPtr& scan) {
   const ros::Time stamp = scan->header.stamp;
   if (!last_scan_stamp_.isZero() && stamp < last_scan_stamp_) {
     // Time went back (a bag restarted, the simulator was reset with a new clock, a stale message).
@@ -110,10 +126,10 @@ void Mapper::onScan(const sensor_msgs::LaserScan::ConstPtr& scan) {
 void Mapper::processPending() {
   while (!pending_.empty()) {
     const sensor_msgs::LaserScan& scan = *pending_.front();
-    if (tf_buffer_.canTransform(options_.odom_frame, options_.base_frame, scan.header.stamp)) {
+    if (odometryArrived(scan.header.stamp)) {
       if (process(scan)) ++processed_;
       pending_.pop_front();
-    } else if ((last_scan_stamp_ - scan.header.stamp).toSec() > options_.tf_wait) {
+    } else if (options_.lockstep || (last_scan_stamp_ - scan.header.stamp).toSec() > options_.tf_wait) {
       ++dropped_;
       ROS_WARN_THROTTLE(5.0, "mapper: no %s -> %s at scan stamp %.3f; scan dropped (%d so far)",
                         options_.odom_frame.c_str(), options_.base_frame.c_str(), scan.header.stamp.toSec(), dropped_);
@@ -122,6 +138,28 @@ void Mapper::processPending() {
       break;
     }
   }
+}
+
+bool Mapper::odometryArrived(const ros::Time& stamp) {
+  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(options_.lockstep ? options_.tf_wait_wall : 0.0);
+  while (!tf_buffer_.canTransform(options_.odom_frame, options_.base_frame, stamp)) {
+    // tf2's own timeout runs on ROS time, which stands still in lockstep: the wall clock bounds the wait.
+    if (ros::WallTime::now() >= deadline || !ros::ok()) return false;
+    ros::WallDuration(0.0005).sleep();
+  }
+  return true;
+}
+
+void Mapper::reportLockstep(const ros::Time& stamp) {
+  hidden_rooms::LockstepAck ack;
+  ack.node = ros::this_node::getName();
+  ack.stamp = stamp;
+  ack.map_stamp = last_map_stamp_;
+  {
+    std::lock_guard<std::mutex> lock(transform_mutex_);
+    ack.transform_stamp = last_tf_sent_;
+  }
+  lockstep_publisher_.publish(ack);
 }
 
 bool Mapper::process(const sensor_msgs::LaserScan& scan) {
@@ -170,8 +208,8 @@ void Mapper::publishTransform(const ros::Time& stamp) {
   if (!map_to_odom_) return;             // no scan processed yet
   if (stamp <= last_tf_stamp_) return;  // time has not moved (simulated clock slower than the timer)
   last_tf_stamp_ = stamp;
-  tf_broadcaster_.sendTransform(toTransform(*map_to_odom_, options_.map_frame, options_.odom_frame,
-                                            stamp + ros::Duration(options_.transform_tolerance)));
+  last_tf_sent_ = stamp + ros::Duration(options_.transform_tolerance);
+  tf_broadcaster_.sendTransform(toTransform(*map_to_odom_, options_.map_frame, options_.odom_frame, last_tf_sent_));
 }
 
 void Mapper::onTimer(const ros::TimerEvent&) { publishTransform(ros::Time::now()); }

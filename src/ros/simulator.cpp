@@ -1,9 +1,10 @@
 #include "hidden_rooms/ros/simulator.h"
 
 #include <cmath>
-#include <thread>
+#include <sstream>
 
 #include <XmlRpcValue.h>
+#include <ros/callback_queue.h>
 #include <geometry_msgs/PolygonStamped.h>
 #include <nav_msgs/Odometry.h>
 #include <sensor_msgs/LaserScan.h>
@@ -74,6 +75,23 @@ bool readPose(const ros::NodeHandle& nh, const std::string& name, common::Pose2*
   return true;
 }
 
+// "a, b" -> the names resolved in the node's namespace ({"/a", "/b"}). Throws InputError for an invalid name.
+std::vector<std::string> resolvedNodeNames(const std::string& list) {
+  std::vector<std::string> names;
+  std::stringstream stream(list);
+  std::string name;
+  while (std::getline(stream, name, ',')) {
+    name.erase(0, name.find_first_not_of(" \t"));
+    name.erase(name.find_last_not_of(" \t") + 1);
+    if (name.empty()) continue;
+    std::string problem;
+    if (!ros::names::validate(name, problem))
+      throw common::InputError("~lockstep_nodes", "'" + name + "' is not a node name: " + problem);
+    names.push_back(ros::names::resolve(name));
+  }
+  return names;
+}
+
 uint64_t periodInSteps(double rate, double physics_step, const std::string& name) {
   if (!std::isfinite(rate) || rate <= 0.0) throw common::InputError("~" + name, "must be positive");
   return std::max<uint64_t>(1, static_cast<uint64_t>(std::llround(1.0 / (rate * physics_step))));
@@ -100,6 +118,12 @@ const common::OptionTable<SimulatorOptions>& simulatorNodeOptionTable() {
       {"base_frame", &O::base_frame, "frame of the robot"},
       {"laser_frame", &O::laser_frame, "frame of the laser"},
       {"publish_world_to_odom", &O::publish_world_to_odom, "static tf world -> odom at the start pose"},
+      {"lockstep_nodes", &O::lockstep_nodes,
+       "nodes (comma-separated) that must report each scan on `lockstep` before the world steps on; \"\" = none"},
+      {"run_until", &O::run_until, "simulated seconds to hold the clock at from the start (as the run_until "
+       "service); 0 = no hold", common::atLeast(0)},
+      {"lockstep_timeout", &O::lockstep_timeout, "wall seconds to wait for one scan's reports before stepping on",
+       common::above(0)},
   };
   return table;
 }
@@ -191,6 +215,16 @@ Simulator::Simulator(ros::NodeHandle nh, const SimulatorOptions& options) : opti
   command_subscriber_ = nh.subscribe("cmd_vel", 10, &Simulator::onCommand, this);
   reset_service_ = nh.advertiseService("reset", &Simulator::onReset, this);
   set_door_service_ = nh.advertiseService("set_door", &Simulator::onSetDoor, this);
+  run_until_service_ = nh.advertiseService("run_until", &Simulator::onRunUntil, this);
+  run_until_ = options.run_until;
+  lockstep_nodes_ = resolvedNodeNames(options.lockstep_nodes);
+  if (!lockstep_nodes_.empty()) {
+    lockstep_subscriber_ = nh.subscribe("lockstep", 100, &Simulator::onLockstepAck, this);
+    std::string names;
+    for (const std::string& name : lockstep_nodes_) names += (names.empty() ? "" : ", ") + name;
+    ROS_INFO("simulator: lockstep with %s: each scan waits for their reports on %s", names.c_str(),
+             lockstep_subscriber_.getTopic().c_str());
+  }
   footprint_publisher_ = nh.advertise<geometry_msgs::PolygonStamped>("footprint", 1, true);
 
   footprint_.header.frame_id = options.base_frame;
@@ -216,39 +250,88 @@ ros::Time Simulator::now() const {
 }
 
 void Simulator::run() {
-  const ros::WallTime wall_start = ros::WallTime::now();
-  const double start = simulation_->time();
+  // Pacing restarts after each hold at the run_until time.
+  ros::WallTime wall_start = ros::WallTime::now();
+  double start = simulation_->time();
   while (ros::ok()) {
     ros::spinOnce();
-    step();
-    const double elapsed = simulation_->time() - start;
+    if (holding()) {
+      ros::getGlobalCallbackQueue()->callAvailable(ros::WallDuration(0.01));
+      wall_start = ros::WallTime::now();
+      start = simulation_->time();
+      continue;
+    }
+    if (step() && !lockstep_nodes_.empty()) waitForLockstep();
     if (options_.duration > 0.0 && simulation_->time() >= options_.duration - 1e-9) break;
     if (options_.realtime_factor > 0.0) {
-      const ros::WallTime due = wall_start + ros::WallDuration(elapsed / options_.realtime_factor);
+      const ros::WallTime due = wall_start + ros::WallDuration((simulation_->time() - start) / options_.realtime_factor);
       const ros::WallTime wall_now = ros::WallTime::now();
       if (due > wall_now) (due - wall_now).sleep();
     }
   }
 }
 
-void Simulator::step() {
+bool Simulator::step() {
   simulation_->step();
   const uint64_t steps = simulation_->steps();
   if (steps % clock_period_steps_ == 0) publishClock();
   if (steps % odom_period_steps_ == 0) publishOdometry();
-  if (steps % laser_period_steps_ == 0) publishScan();
+  if (steps % laser_period_steps_ != 0) return false;
+  publishScan();
+  return true;
+}
+
+bool Simulator::holding() const { return run_until_ > 0.0 && simulation_->time() >= run_until_ - 1e-9; }
+
+std::vector<std::string> Simulator::lockstepMissing() const {
+  const ros::Time stamp = last_scan_.header.stamp;
+  std::vector<std::string> missing;
+  for (const std::string& node : lockstep_nodes_) {
+    const auto ack = lockstep_acks_.find(node);
+    const auto commands = commands_received_.find(node);
+    const uint32_t received = commands == commands_received_.end() ? 0 : commands->second;
+    if (ack == lockstep_acks_.end() || ack->second.stamp < stamp || received < ack->second.commands)
+      missing.push_back(node);
+  }
+  return missing;
+}
+
+void Simulator::waitForLockstep() {
+  lockstep_waiting_ = true;
+  const ros::WallTime started = ros::WallTime::now();
+  ros::WallTime last_sent = started;
+  std::vector<std::string> missing = lockstepMissing();
+  while (!missing.empty() && ros::ok()) {
+    const ros::WallTime wall_now = ros::WallTime::now();
+    if ((wall_now - started).toSec() > options_.lockstep_timeout) {
+      std::string names;
+      for (const std::string& name : missing) names += (names.empty() ? "" : ", ") + name;
+      ROS_WARN("simulator: lockstep: no report of the scan at %.2f s from %s in %.0f s (wall); stepping on",
+               last_scan_.header.stamp.toSec(), names.c_str(), options_.lockstep_timeout);
+      break;
+    }
+    if ((wall_now - last_sent).toSec() >= 1.0) {  // a node that subscribed after the scan was sent gets it now
+      clock_publisher_.publish(last_clock_);
+      tf_broadcaster_.sendTransform(last_odometry_transform_);
+      scan_publisher_.publish(last_scan_);
+      last_sent = wall_now;
+    }
+    ros::getGlobalCallbackQueue()->callAvailable(ros::WallDuration(0.001));
+    missing = lockstepMissing();
+  }
+  lockstep_waiting_ = false;
 }
 
 void Simulator::publishClock() {
-  rosgraph_msgs::Clock clock;
-  clock.clock = now();
-  clock_publisher_.publish(clock);
+  last_clock_.clock = now();
+  clock_publisher_.publish(last_clock_);
 }
 
 void Simulator::publishScan() {
   simulation_->scan(&ranges_);
-  scan_publisher_.publish(toRos(ranges_, simulation_->laserGeometry(), options_.simulation.laser.min_range,
-                                laser_period_steps_ * options_.simulation.physics_step, options_.laser_frame, now()));
+  last_scan_ = toRos(ranges_, simulation_->laserGeometry(), options_.simulation.laser.min_range,
+                     laser_period_steps_ * options_.simulation.physics_step, options_.laser_frame, now());
+  scan_publisher_.publish(last_scan_);
 }
 
 void Simulator::publishOdometry() {
@@ -257,18 +340,44 @@ void Simulator::publishOdometry() {
   odom_publisher_.publish(toRos(odometry, simulation_->odometryVelocity(), options_.odom_frame, options_.base_frame, stamp));
   ground_truth_publisher_.publish(
       toRos(simulation_->truePose(), simulation_->velocity(), options_.world_frame, options_.base_frame, stamp));
-  tf_broadcaster_.sendTransform(toTransform(odometry, options_.odom_frame, options_.base_frame, stamp));
+  last_odometry_transform_ = toTransform(odometry, options_.odom_frame, options_.base_frame, stamp);
+  tf_broadcaster_.sendTransform(last_odometry_transform_);
   // Stamped with the pose it goes with: rviz places a polygon once, at its stamp's transform.
   footprint_.header.stamp = stamp;
   footprint_publisher_.publish(footprint_);
 }
 
-void Simulator::onCommand(const geometry_msgs::Twist::ConstPtr& command) {
+void Simulator::onCommand(const ros::MessageEvent<geometry_msgs::Twist const>& event) {
+  ++commands_received_[event.getPublisherName()];
   try {
-    simulation_->setCommand(fromRos(*command));
+    simulation_->setCommand(fromRos(*event.getMessage()));
   } catch (const common::InputError& error) {
     ROS_WARN_THROTTLE(1.0, "simulator: ignoring %s", error.what());
   }
+}
+
+void Simulator::onLockstepAck(const hidden_rooms::LockstepAck::ConstPtr& ack) {
+  hidden_rooms::LockstepAck& last = lockstep_acks_[ack->node];
+  if (ack->stamp >= last.stamp) last = *ack;  // a late re-sent report never goes back
+}
+
+bool Simulator::onRunUntil(hidden_rooms::RunUntil::Request& request, hidden_rooms::RunUntil::Response& response) {
+  response.now = simulation_->time();
+  if (!std::isfinite(request.time) || request.time < 0.0) {
+    response.success = false;
+    response.message = "time must be a finite number of seconds >= 0 (0 = no limit), got " +
+                       common::formatNumber(request.time);
+    return true;
+  }
+  run_until_ = request.time;
+  response.success = true;
+  response.reached = holding() && !lockstep_waiting_;
+  for (const auto& [node, ack] : lockstep_acks_)
+    if (ack.finished) response.finished.push_back(node);
+  response.message = run_until_ == 0.0 ? "running without a limit"
+                     : response.reached ? "holding at " + common::formatNumber(response.now) + " s"
+                                        : "running to " + common::formatNumber(run_until_) + " s";
+  return true;
 }
 
 bool Simulator::onReset(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& response) {

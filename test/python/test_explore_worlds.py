@@ -2,7 +2,8 @@
 """scripts/explore_worlds end to end on test/data/simulator_corridor.xml (a corridor with two rooms) with door 1
 closed: its own ROS master, simulator + mapper + explorer + pose_logger until the explorer is done, then the
 saved map, the door translated into the map frame, the true room, the prediction and the summary; short runs back to
-back, each starting its simulated time near 0 (its first pose within the 15 s the nodes take to start at 10x); bad input; the wait for /use_sim_time (on a bare master); and the
+back, each starting its simulated time near 0 (its first pose within the 15 s the nodes take to start at 10x); two
+lockstep runs (--realtime-factor 0) of one seed that agree exactly; bad input; the wait for /use_sim_time (on a bare master); and the
 no_growth rule and the progress status (these two without ROS).
 
 Needs the built package (found like the scripts find it: $CMAKE_PREFIX_PATH, else the checkout's .ws) and
@@ -236,6 +237,45 @@ class ExploreWorldsTest(unittest.TestCase):
         finally:
             shutil.rmtree(folder, ignore_errors=True)
 
+    def test_lockstep_runs_of_one_seed_are_the_same(self):
+        # --realtime-factor 0: the simulator steps on when the mapper and the explorer have handled each scan, and
+        # holds at each check and save time; two runs side by side (each slowing the other) must agree exactly.
+        folder = tempfile.mkdtemp(prefix="hidden_rooms_explore_worlds_lockstep_")
+        try:
+            worlds = []
+            for name in ("first", "second"):
+                worlds.append(os.path.join(folder, name + ".xml"))
+                shutil.copy(WORLD, worlds[-1])
+            out = os.path.join(folder, "out")
+            result = run(*worlds, "--out", out, *RUN_OPTIONS[:4], "--max-time", "40", "--realtime-factor", "0",
+                         "--method", "", "--jobs", "2", "--no-progress", timeout=300)
+            self.assertEqual(result.returncode, 0, result.stdout + result.stderr)
+            with open(os.path.join(out, "summary.csv")) as summary_file:
+                rows = list(csv.DictReader(summary_file))
+            self.assertEqual(len(rows), 2)
+            for key in ("status", "sim_time_s", "path_length_m", "coverage", "free_iou", "worst_door_error_m"):
+                self.assertEqual(rows[0][key], rows[1][key], key)
+            self.assertIn(rows[0]["status"], ("done", "max_time"))
+            self.assertLessEqual(float(rows[0]["sim_time_s"]), 40.0)
+            first, second = (os.path.join(out, name) for name in ("first", "second"))
+            saved = sorted(os.listdir(os.path.join(first, "maps")))
+            self.assertTrue(saved, "no map saved at the timeouts")
+            self.assertEqual(saved, sorted(os.listdir(os.path.join(second, "maps"))))
+            for name in ["map.pgm", "map.yaml"] + [os.path.join("maps", map_file) for map_file in saved]:
+                with open(os.path.join(first, name), "rb") as a, open(os.path.join(second, name), "rb") as b:
+                    self.assertEqual(a.read(), b.read(), name + " differs")
+            # The pose logger is not in the lockstep: when it starts is the machine's; its poses are the run's.
+            for name in ("poses_truth.log", "poses_map.log"):
+                logs = []
+                for run_dir in (first, second):
+                    with open(os.path.join(run_dir, name)) as log:
+                        logs.append({line.split()[0]: line for line in log if not line.startswith("#")})
+                common = set(logs[0]) & set(logs[1])
+                self.assertGreater(len(common), 0.9 * max(len(logs[0]), len(logs[1])), name)
+                self.assertEqual([logs[0][t] for t in sorted(common)], [logs[1][t] for t in sorted(common)], name)
+        finally:
+            shutil.rmtree(folder, ignore_errors=True)
+
     def test_bad_input_exits_2_with_a_message(self):
         missing = run(os.path.join(self.out, "no_such_world.xml"), "--out", self.out)
         self.assertEqual(missing.returncode, 2)
@@ -246,6 +286,9 @@ class ExploreWorldsTest(unittest.TestCase):
         bad_random = run(WORLD, "--out", os.path.join(self.out, "bad"), "--closed", "random:x")
         self.assertEqual(bad_random.returncode, 2)
         self.assertIn("random:N", bad_random.stderr)
+        negative = run(WORLD, "--out", os.path.join(self.out, "bad"), "--realtime-factor", "-1")
+        self.assertEqual(negative.returncode, 2)
+        self.assertIn("--realtime-factor", negative.stderr)
 
 
 if __name__ == "__main__":

@@ -1,9 +1,11 @@
 #pragma once
 
+#include <deque>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include <hidden_rooms/LockstepAck.h>
 #include <nav_msgs/OccupancyGrid.h>
 #include <ros/ros.h>
 #include <sensor_msgs/LaserScan.h>
@@ -27,6 +29,12 @@ struct ExplorerOptions : exploration::ExplorationPolicyOptions {
   double pose_timeout = 1.0;        // seconds (ROS time): an older map -> base transform stops the robot
   double map_timeout = 10.0;        // seconds (ROS time) without a new map (mapper down) stop the robot; 0 = never
   bool start_paused = false;        // wait for true on ~resume before exploring
+  // Lockstep with the simulator (its ~lockstep_nodes) behind this mapper node: one control step per scan, at the
+  // scan's stamp, with the map and map -> odom the mapper reported for the scan before, planning in place; each
+  // step is reported on `lockstep`. "" = free-running on the control timer.
+  std::string lockstep_mapper;
+  std::string odom_frame = "odom";  // lockstep: the frame the robot's pose is chained through (map -> odom -> base)
+  double lockstep_wait = 5.0;       // wall seconds a lockstep step waits for the mapper's results before holding
 };
 
 // The node's own parameters (frames, rates, timeouts); the policy's are in the core's tables.
@@ -40,7 +48,8 @@ ExplorerOptions readExplorerOptions(const ros::NodeHandle& private_nh);
 // `map`, the robot's pose from tf and the laser on `base_scan`: publishes its commands on `cmd_vel`, its state on
 // `exploration_markers`, the latched `exploration_done` and `exploration_status`, and logs its events. Stops (and
 // holds the policy) while the map, the pose or the scan is stale, and while paused: false on `~resume`
-// (std_msgs/Bool, as explore_lite's resume topic) pauses, true resumes with the same goal and blacklist.
+// (std_msgs/Bool, as explore_lite's resume topic) pauses, true resumes with the same goal and blacklist. In
+// lockstep (~lockstep_mapper) the steps follow the scans instead of the timer (see ExplorerOptions).
 class Explorer {
  public:
   // Subscribes and advertises; does not wait for anything (the control timer does the work).
@@ -53,7 +62,16 @@ class Explorer {
   void onScan(const sensor_msgs::LaserScan::ConstPtr& scan);
   void onResume(const std_msgs::Bool::ConstPtr& resume);
   void onTimer(const ros::TimerEvent& event);
-  bool robotPose(common::Pose2* pose);
+  void onLockstepAck(const hidden_rooms::LockstepAck::ConstPtr& ack);
+  // Gives the policy a map (stamped `received` for the map timeout).
+  void applyMap(const nav_msgs::OccupancyGrid::ConstPtr& map, const ros::Time& received);
+  // The control step at ROS time `now`: checks the map, pose and scan, updates the policy, publishes.
+  void controlStep(const ros::Time& now);
+  // Lockstep: takes the control step of the pending scan once the mapper's results for the scan before it (its
+  // report, the map it names, map -> odom) are here, or after ~lockstep_wait without them; then reports.
+  void tryLockstepStep();
+  void reportLockstep(const ros::Time& stamp);
+  bool robotPose(const ros::Time& now, common::Pose2* pose);
   // Stops the robot from outside the policy (stale map, pose or scan): the follower's timers do not count it.
   void holdRobot(const ros::Time& now);
   // Logs the policy's events as ROS_INFO / ROS_WARN lines and publishes exploration_done when it changes.
@@ -88,6 +106,17 @@ class Explorer {
   ros::Publisher markers_publisher_;
   ros::Publisher status_publisher_;
   ros::Timer timer_;
+  // Lockstep state.
+  std::string lockstep_mapper_;  // resolved name; "" = free-running
+  ros::Subscriber lockstep_subscriber_;
+  ros::Publisher lockstep_publisher_;
+  std::deque<hidden_rooms::LockstepAck> mapper_acks_;  // the mapper's reports not yet used, oldest first
+  std::deque<nav_msgs::OccupancyGrid::ConstPtr> pending_maps_;  // maps not yet given to the policy, oldest first
+  sensor_msgs::LaserScan::ConstPtr pending_scan_;  // the scan whose step is due
+  ros::WallTime pending_since_;
+  ros::Time last_step_stamp_;       // stamp of the last scan stepped
+  ros::Time transform_stamp_;       // map -> odom stamp of the step's pose (the mapper's report)
+  uint32_t commands_published_ = 0;
 };
 
 }  // namespace hidden_rooms

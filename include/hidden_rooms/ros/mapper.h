@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include <hidden_rooms/LockstepAck.h>
 #include <hidden_rooms/SaveMap.h>
 #include <nav_msgs/GetMap.h>
 #include <ros/callback_queue.h>
@@ -35,6 +36,10 @@ struct MapperOptions {
   // otherwise make every following scan look out of order). 0 = no check.
   double future_stamp_tolerance = 1.0;
   bool publish_particles = true;      // publish `particles` (geometry_msgs/PoseArray)
+  // Lockstep with the simulator (its ~lockstep_nodes): report each scan on `lockstep` once handled, wait for its
+  // odometry as long as it takes (wall clock, up to ~tf_wait_wall) and publish map -> odom after each scan only.
+  bool lockstep = false;
+  double tf_wait_wall = 5.0;          // wall seconds a scan waits for its odometry in lockstep
 };
 
 // The node's own parameters (topic, frames, rates, waits, particles); the ini's are in the core's table.
@@ -63,7 +68,12 @@ class Mapper {
 
  private:
   void onScan(const sensor_msgs::LaserScan::ConstPtr& scan);
+  // Handles the scan (processes, drops or ignores it), then reports it in lockstep.
+  void handleScan(const sensor_msgs::LaserScan::ConstPtr& scan);
   void processPending();
+  // Whether odom -> base_frame at `stamp` is in the tf buffer; in lockstep, waits for it up to ~tf_wait_wall.
+  bool odometryArrived(const ros::Time& stamp);
+  void reportLockstep(const ros::Time& stamp);
   bool process(const sensor_msgs::LaserScan& scan);
   void publishMap(const ros::Time& stamp);
   // Publishes the last map -> odom (if any) at `stamp` + transform_tolerance, once per stamp.
@@ -96,6 +106,8 @@ class Mapper {
   std::mutex transform_mutex_;
   std::optional<common::Pose2> map_to_odom_;
   ros::Time last_tf_stamp_;
+  ros::Time last_tf_sent_;  // stamp map -> odom was last broadcast with (last_tf_stamp_ + transform_tolerance)
+  ros::Publisher lockstep_publisher_;
   // The tf timer's own queue and thread (declared last: the thread stops before the timer and queue go).
   ros::CallbackQueue tf_queue_;
   ros::Timer tf_timer_;

@@ -1,14 +1,19 @@
 #pragma once
 
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include <geometry_msgs/PolygonStamped.h>
+#include <geometry_msgs/TransformStamped.h>
 #include <geometry_msgs/Twist.h>
+#include <hidden_rooms/LockstepAck.h>
+#include <hidden_rooms/RunUntil.h>
 #include <hidden_rooms/SetDoor.h>
 #include <ros/ros.h>
 #include <rosgraph_msgs/Clock.h>
+#include <sensor_msgs/LaserScan.h>
 #include <std_srvs/Trigger.h>
 #include <tf2_ros/static_transform_broadcaster.h>
 #include <tf2_ros/transform_broadcaster.h>
@@ -33,6 +38,11 @@ struct SimulatorOptions {
   double odom_rate = 20.0;        // Hz of simulated time (odom, base_pose_ground_truth, tf odom -> base_link)
   double clock_rate = 100.0;      // Hz of simulated time (/clock); at most once per physics step
   double duration = 0.0;          // simulated seconds after which the node exits; 0 = run until shut down
+  // Lockstep: nodes (names, comma-separated, resolved in the node's namespace) that must report each scan on
+  // `lockstep` (and whose reported cmd_vel must have arrived) before the world steps on; "" = free-running.
+  std::string lockstep_nodes;
+  double run_until = 0.0;          // simulated seconds to hold the clock at until run_until asks for more; 0 = none
+  double lockstep_timeout = 30.0;  // wall seconds to wait for the reports of one scan before stepping on anyway
   std::string world_frame = "world";
   std::string odom_frame = "odom";
   std::string base_frame = "base_link";
@@ -52,21 +62,34 @@ SimulatorOptions readSimulatorOptions(const ros::NodeHandle& private_nh);
 
 // Stage/stage_ros's job on the core's Box2D simulation: steps the world with a fixed physics step at
 // `realtime_factor`, publishes /clock, base_scan, odom, base_pose_ground_truth and tf, follows cmd_vel, and
-// serves reset and set_door.
+// serves reset, set_door and run_until (hold the clock at a time). In lockstep (~lockstep_nodes) it waits after
+// each scan until every named node has reported it on `lockstep` and their commands have arrived, re-sending the
+// scan with its clock and odometry every second meanwhile (to a node that subscribed late): the same seed then
+// gives the same run however fast the machine is.
 class Simulator {
  public:
   // Loads the world and builds the simulation (throws InputError when it cannot); does not wait for anything.
   Simulator(ros::NodeHandle nh, const SimulatorOptions& options);
 
-  // Steps and publishes until ROS shuts down or ~duration is reached, pacing to realtime_factor.
+  // Steps and publishes until ROS shuts down or ~duration is reached, pacing to realtime_factor, holding at the
+  // run_until time and waiting for the lockstep nodes after each scan.
   void run();
-  // One physics step and whatever is due after it (publications at their rates). Callbacks are not handled.
-  void step();
+  // One physics step and whatever is due after it (publications at their rates); true when a scan was published.
+  // Callbacks are not handled.
+  bool step();
   const simulation::Simulation& simulation() const { return *simulation_; }
   ros::Time now() const;
 
  private:
-  void onCommand(const geometry_msgs::Twist::ConstPtr& command);
+  void onCommand(const ros::MessageEvent<geometry_msgs::Twist const>& event);
+  void onLockstepAck(const hidden_rooms::LockstepAck::ConstPtr& ack);
+  bool onRunUntil(hidden_rooms::RunUntil::Request& request, hidden_rooms::RunUntil::Response& response);
+  bool holding() const;
+  // Lockstep nodes that have not yet reported the last scan (or whose reported commands have not arrived).
+  std::vector<std::string> lockstepMissing() const;
+  // Handles callbacks until lockstepMissing() is empty, re-sending the last scan every wall second; after
+  // ~lockstep_timeout it warns, naming the nodes, and returns.
+  void waitForLockstep();
   bool onReset(std_srvs::Trigger::Request& request, std_srvs::Trigger::Response& response);
   bool onSetDoor(hidden_rooms::SetDoor::Request& request, hidden_rooms::SetDoor::Response& response);
   void publishClock();
@@ -79,6 +102,15 @@ class Simulator {
   uint64_t odom_period_steps_ = 1;
   uint64_t clock_period_steps_ = 1;
   std::vector<float> ranges_;
+  // The last publications, kept for lockstep's re-sending: the same messages, not a new noisy scan.
+  rosgraph_msgs::Clock last_clock_;
+  sensor_msgs::LaserScan last_scan_;
+  geometry_msgs::TransformStamped last_odometry_transform_;
+  std::vector<std::string> lockstep_nodes_;  // resolved names
+  std::map<std::string, hidden_rooms::LockstepAck> lockstep_acks_;  // each node's last report
+  std::map<std::string, uint32_t> commands_received_;  // cmd_vel messages by publisher
+  bool lockstep_waiting_ = false;
+  double run_until_ = 0.0;  // simulated seconds to hold at; 0 = none
   ros::Publisher clock_publisher_;
   ros::Publisher scan_publisher_;
   ros::Publisher odom_publisher_;
@@ -88,6 +120,8 @@ class Simulator {
   ros::Subscriber command_subscriber_;
   ros::ServiceServer reset_service_;
   ros::ServiceServer set_door_service_;
+  ros::ServiceServer run_until_service_;
+  ros::Subscriber lockstep_subscriber_;
   tf2_ros::TransformBroadcaster tf_broadcaster_;
   tf2_ros::StaticTransformBroadcaster static_tf_broadcaster_;
 };
