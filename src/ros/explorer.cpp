@@ -182,7 +182,10 @@ void Explorer::tryLockstepStep() {
                       last_step_stamp_.toSec(), options_.lockstep_wait);
   }
   // The newest map up to the reported one (maps the mapper published later wait for their step).
-  while (!pending_maps_.empty() && (map_stamp.isZero() ? !reported : pending_maps_.front()->header.stamp <= map_stamp)) {
+  const auto due = [&](const nav_msgs::OccupancyGrid& map) {
+    return map_stamp.isZero() ? !reported : map.header.stamp <= map_stamp;
+  };
+  while (!pending_maps_.empty() && due(*pending_maps_.front())) {
     applyMap(pending_maps_.front(), stamp);
     pending_maps_.pop_front();
   }

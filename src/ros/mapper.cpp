@@ -141,7 +141,8 @@ void Mapper::processPending() {
 }
 
 bool Mapper::odometryArrived(const ros::Time& stamp) {
-  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(options_.lockstep ? options_.tf_wait_wall : 0.0);
+  const double wait = options_.lockstep ? options_.tf_wait_wall : 0.0;
+  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(wait);
   while (!tf_buffer_.canTransform(options_.odom_frame, options_.base_frame, stamp)) {
     // tf2's own timeout runs on ROS time, which stands still in lockstep: the wall clock bounds the wait.
     if (ros::WallTime::now() >= deadline || !ros::ok()) return false;

@@ -79,8 +79,12 @@ RoomPredictorNode::RoomPredictorNode(ros::NodeHandle nh, const RoomPredictorOpti
     if (file_parameters_.count(parameter.name)) parameter.value = file_parameters_.at(parameter.name);
   initial.__fromMessage__(initial_message);
   applied_config_ = initial;
-  reconfigure_server_ = std::make_unique<dynamic_reconfigure::Server<RoomPredictorConfig>>(ros::NodeHandle("~"));
-  reconfigure_server_->updateConfig(initial);
+  reconfigure_server_ =
+      std::make_unique<dynamic_reconfigure::Server<RoomPredictorConfig>>(reconfigure_mutex_, ros::NodeHandle("~"));
+  {
+    boost::recursive_mutex::scoped_lock lock(reconfigure_mutex_);
+    reconfigure_server_->updateConfig(initial);
+  }
   reconfigure_server_->setCallback(
       [this](RoomPredictorConfig& config, uint32_t level) { reconfigure(config, level); });
   map_topic_ = nh.resolveName("map");

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include <boost/thread/recursive_mutex.hpp>
 #include <dynamic_reconfigure/server.h>
 #include <geometry_msgs/PointStamped.h>
 #include <hidden_rooms/PredictRooms.h>
@@ -94,6 +95,8 @@ class RoomPredictorNode {
   std::string method_;
   std::map<std::string, double> parameters_;
   RoomPredictorConfig applied_config_;  // the configuration method_ and parameters_ come from
+  // The server's mutex is the node's, so that its configuration can be set at start (updateConfig) under it.
+  boost::recursive_mutex reconfigure_mutex_;
   std::unique_ptr<dynamic_reconfigure::Server<RoomPredictorConfig>> reconfigure_server_;
   nav_msgs::OccupancyGrid::ConstPtr latest_map_;
   std::string map_topic_;
