@@ -1,7 +1,6 @@
 #include "hidden_rooms/ros/simulator.h"
 
 #include <cmath>
-#include <sstream>
 
 #include <XmlRpcValue.h>
 #include <ros/callback_queue.h>
@@ -78,11 +77,7 @@ bool readPose(const ros::NodeHandle& nh, const std::string& name, common::Pose2*
 // "a, b" -> the names resolved in the node's namespace ({"/a", "/b"}). Throws InputError for an invalid name.
 std::vector<std::string> resolvedNodeNames(const std::string& list) {
   std::vector<std::string> names;
-  std::stringstream stream(list);
-  std::string name;
-  while (std::getline(stream, name, ',')) {
-    name.erase(0, name.find_first_not_of(" \t"));
-    name.erase(name.find_last_not_of(" \t") + 1);
+  for (const std::string& name : common::splitList(list)) {
     if (name.empty()) continue;
     std::string problem;
     if (!ros::names::validate(name, problem))

@@ -23,18 +23,10 @@ using namespace hidden_rooms;
 
 namespace {
 
-std::vector<std::string> splitList(const std::string& text) {
-  std::vector<std::string> items;
-  std::stringstream stream(text);
-  std::string item;
-  while (std::getline(stream, item, ','))
-    if (!item.empty()) items.push_back(item);
-  return items;
-}
-
 std::vector<int> parseNumbers(const std::string& text, const std::string& option) {
   std::vector<int> numbers;
-  for (const std::string& item : splitList(text)) {
+  for (const std::string& item : common::splitList(text)) {
+    if (item.empty()) continue;
     size_t used = 0;
     int value = 0;
     try {
@@ -129,7 +121,8 @@ int run(int argc, char** argv) {
   const world::Environment environment = world::loadEnvironment(environment_path);
   world::printRepairs(environment, environment_path, std::cerr);
   std::vector<std::unique_ptr<prediction::RoomPredictor>> methods;
-  for (const std::string& name : splitList(methods_text)) methods.push_back(prediction::makeRoomPredictor(name));
+  for (const std::string& name : common::splitList(methods_text))
+    if (!name.empty()) methods.push_back(prediction::makeRoomPredictor(name));
   std::map<std::string, double> parameters;
   if (!params_path.empty()) parameters = prediction::loadParameterFile(params_path);
   try {  // unknown names fail up front

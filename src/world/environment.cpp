@@ -10,7 +10,6 @@
 #include <functional>
 #include <limits>
 #include <map>
-#include <sstream>
 
 #include "hidden_rooms/common/file_io.h"
 #include "hidden_rooms/common/input_error.h"
@@ -605,11 +604,7 @@ std::set<int> parseDoorSelection(const Environment& environment, const std::stri
     return selected;
   }
   if (spec.find_first_not_of(' ') == std::string::npos) return selected;  // no door
-  std::stringstream items(spec + ",");  // the comma makes a trailing empty item show
-  std::string item;
-  while (std::getline(items, item, ',')) {
-    item.erase(0, item.find_first_not_of(' '));
-    item.erase(item.find_last_not_of(' ') + 1);
+  for (const std::string& item : common::splitList(spec)) {
     if (item.empty())
       throw common::InputError(source_name, "'" + spec + "' has an empty door number between its commas");
     const int index = environment.findDoor(item);

@@ -77,5 +77,13 @@ TEST(Options, DescriptionsShowTypesAndDefaults) {
   EXPECT_EQ(rows[3].meaning, "a frame");
 }
 
+TEST(SplitList, TrimsItemsAndKeepsEmptyOnes) {
+  EXPECT_EQ(splitList(""), std::vector<std::string>{});
+  EXPECT_EQ(splitList("mapper"), std::vector<std::string>{"mapper"});
+  EXPECT_EQ(splitList(" a, b\t,,c,"), (std::vector<std::string>{"a", "b", "", "c", ""}));
+  EXPECT_EQ(splitList("  "), std::vector<std::string>{""});
+  EXPECT_EQ(splitList("1;2", ';'), (std::vector<std::string>{"1", "2"}));
+}
+
 }  // namespace
 }  // namespace hidden_rooms::common

@@ -2,6 +2,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace hidden_rooms::common {
 
@@ -22,5 +23,9 @@ class InputError : public std::runtime_error {
 
 // A number as messages and files show it (printf's %.10g: integers stay integers, "inf" for infinity).
 std::string formatNumber(double value);
+
+// The items of a list as inputs write it ("a, b,,c," -> {"a", "b", "", "c", ""}), each without the spaces and tabs
+// around it; "" has no item. Callers decide what an empty item means.
+std::vector<std::string> splitList(const std::string& text, char separator = ',');
 
 }  // namespace hidden_rooms::common
