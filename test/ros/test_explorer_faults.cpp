@@ -16,6 +16,7 @@
 
 #include <geometry_msgs/Twist.h>
 #include <gtest/gtest.h>
+#include <hidden_rooms/ExplorationStatus.h>
 #include <nav_msgs/OccupancyGrid.h>
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
@@ -66,6 +67,9 @@ class ExplorerFaultsTest : public ::testing::Test {
       done_ = m->data;
       if (m->data && pinned_) done_while_pinned_ = true;
     });
+    status_subscriber_ = nh_.subscribe<ExplorationStatus>(
+        "exploration_status", 10, [this](const ExplorationStatus::ConstPtr& m) { status_ = m; });
+    resume_publisher_ = nh_.advertise<std_msgs::Bool>("explorer/resume", 1, true);
     rosout_subscriber_ = nh_.subscribe<rosgraph_msgs::Log>(
         "/rosout", 1000, [this](const rosgraph_msgs::Log::ConstPtr& m) { log_.push_back(m); });
   }
@@ -127,8 +131,20 @@ class ExplorerFaultsTest : public ::testing::Test {
   bool pinned_ = false;
   bool done_ = false;
   bool done_while_pinned_ = false;
-  ros::Publisher map_publisher_, command_publisher_;
-  ros::Subscriber command_subscriber_, truth_subscriber_, done_subscriber_, rosout_subscriber_;
+  // Publishes `run` on explorer/resume once the explorer listens; returns the ROS time the explorer reported the
+  // new state at (its exploration_status), or a negative number when it did not within the wall timeout.
+  double setRunning(bool run) {
+    if (!waitFor([this] { return resume_publisher_.getNumSubscribers() > 0; }, 30.0)) return -1.0;
+    std_msgs::Bool flag;
+    flag.data = run;
+    resume_publisher_.publish(flag);
+    if (!waitFor([&] { return status_ && status_->paused == !run; }, 30.0)) return -1.0;
+    return status_->stamp.toSec();
+  }
+
+  ros::Publisher map_publisher_, command_publisher_, resume_publisher_;
+  ros::Subscriber command_subscriber_, truth_subscriber_, done_subscriber_, rosout_subscriber_, status_subscriber_;
+  ExplorationStatus::ConstPtr status_;
   std::vector<TimedCommand> commands_;
   std::vector<TimedPosition> positions_;
   std::vector<rosgraph_msgs::Log::ConstPtr> log_;
@@ -140,23 +156,21 @@ TEST_F(ExplorerFaultsTest, PausesStopsWithoutMapsAndRecoversWhenPinned) {
   const common::Point2 start = *position();
   ASSERT_TRUE(waitFor([&] { return movedFrom(start, 0.3); }, 30.0)) << "the explorer did not drive";
 
-  // 0. Paused for 9 simulated seconds, beyond progress_timeout (6 s) and stall_timeout (1 s).
-  ros::Publisher resume = nh_.advertise<std_msgs::Bool>("explorer/resume", 1, true);
-  std_msgs::Bool flag;
-  flag.data = false;
-  resume.publish(flag);
-  const double paused = ros::Time::now().toSec();
+  // 0. Paused for 9 simulated seconds, beyond progress_timeout (6 s) and stall_timeout (1 s), counted from when
+  // the explorer took the pause (on a busy machine the message's way can take longer than a control period).
+  const double paused = setRunning(false);
+  ASSERT_GT(paused, 0.0) << "the explorer did not report the pause on exploration_status";
   ASSERT_TRUE(waitUntilSimTime(paused + 9.0, 30.0));
-  const double paused_by = paused + 0.5;  // a control period (0.1 s) and the message's way
-  for (const TimedCommand& command : commands_)
-    if (command.time > paused_by)
-      EXPECT_TRUE(command.linear == 0.0 && command.angular == 0.0)
-          << "moving command " << command.linear << ", " << command.angular << " at " << command.time
-          << " s, paused at " << paused << " s";
+  const double paused_by = paused + 0.5;  // its control step after the pause (0.1 s), and the commands' way
+  for (const TimedCommand& command : commands_) {
+    if (command.time <= paused_by) continue;
+    EXPECT_TRUE(command.linear == 0.0 && command.angular == 0.0)
+        << "moving command " << command.linear << ", " << command.angular << " at " << command.time
+        << " s, paused at " << paused << " s";
+  }
   EXPECT_LT(motionBetween(paused_by + 1.0, paused + 9.0), 0.03) << "the robot did not stop when paused";
-  flag.data = true;
-  resume.publish(flag);
-  const double unpaused = ros::Time::now().toSec();
+  const double unpaused = setRunning(true);
+  ASSERT_GT(unpaused, 0.0) << "the explorer did not report the resume on exploration_status";
   const common::Point2 unpaused_at = *position();
   ASSERT_TRUE(waitFor([&] { return movedFrom(unpaused_at, 0.3); }, 20.0)) << "no driving after resume";
   EXPECT_EQ(explorerWarnings("not reached", paused, unpaused + 1.5), 0) << "the pause failed the goal";
