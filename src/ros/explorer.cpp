@@ -10,6 +10,7 @@
 #include "hidden_rooms/common/input_error.h"
 #include "hidden_rooms/common/range_scan.h"
 #include "hidden_rooms/ros/conversions.h"
+#include "hidden_rooms/ros/lockstep.h"
 #include "hidden_rooms/ros/markers.h"
 #include "hidden_rooms/ros/parameters.h"
 
@@ -85,10 +86,7 @@ Explorer::Explorer(ros::NodeHandle nh, const ExplorerOptions& options)
   if (options.lockstep_mapper.empty()) {
     timer_ = nh.createTimer(ros::Duration(1.0 / options.control_rate), &Explorer::onTimer, this);
   } else {
-    std::string problem;
-    if (!ros::names::validate(options.lockstep_mapper, problem))
-      throw common::InputError("~lockstep_mapper", "'" + options.lockstep_mapper + "' is not a node name: " + problem);
-    lockstep_mapper_ = ros::names::resolve(options.lockstep_mapper);
+    lockstep_mapper_ = resolvedNodeName(options.lockstep_mapper, "lockstep_mapper");
     lockstep_publisher_ = nh.advertise<hidden_rooms::LockstepAck>("lockstep", 10, true);
     lockstep_subscriber_ = nh.subscribe("lockstep", 100, &Explorer::onLockstepAck, this);
     reportLockstep(ros::Time());  // ready
@@ -197,9 +195,7 @@ void Explorer::tryLockstepStep() {
 }
 
 void Explorer::reportLockstep(const ros::Time& stamp) {
-  hidden_rooms::LockstepAck ack;
-  ack.node = ros::this_node::getName();
-  ack.stamp = stamp;
+  hidden_rooms::LockstepAck ack = lockstepReport(stamp);
   ack.commands = commands_published_;
   ack.finished = policy_.done();
   lockstep_publisher_.publish(ack);
@@ -228,13 +224,11 @@ bool Explorer::robotPose(const ros::Time& now, common::Pose2* pose) {
       *pose = fromRos(transform.transform);
       return true;
     }
-    // Lockstep: map -> odom as the mapper reported it, odom -> base at the scan's stamp (tf's thread brings them;
-    // tf2's own timeout runs on ROS time, which stands still here).
+    // Lockstep: map -> odom as the mapper reported it, odom -> base at the scan's stamp (tf's thread brings them).
     if (transform_stamp_.isZero()) throw tf2::LookupException("the mapper has reported no map -> odom yet");
-    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(options_.lockstep_wait);
-    while (!tf_buffer_.canTransform(options_.map_frame, transform_stamp_, options_.base_frame, now,
-                                    options_.odom_frame) && ros::WallTime::now() < deadline && ros::ok())
-      ros::WallDuration(0.0005).sleep();
+    waitOnWallClock([&] {
+      return tf_buffer_.canTransform(options_.map_frame, transform_stamp_, options_.base_frame, now, options_.odom_frame);
+    }, options_.lockstep_wait);
     *pose = fromRos(tf_buffer_.lookupTransform(options_.map_frame, transform_stamp_, options_.base_frame, now,
                                                options_.odom_frame).transform);
     return true;

@@ -7,6 +7,7 @@
 #include "hidden_rooms/common/input_error.h"
 #include "hidden_rooms/common/occupancy_grid.h"
 #include "hidden_rooms/ros/conversions.h"
+#include "hidden_rooms/ros/lockstep.h"
 #include "ros/mrpt_scan.h"
 #include "hidden_rooms/ros/parameters.h"
 
@@ -141,24 +142,16 @@ void Mapper::processPending() {
 }
 
 bool Mapper::odometryArrived(const ros::Time& stamp) {
-  const double wait = options_.lockstep ? options_.tf_wait_wall : 0.0;
-  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(wait);
-  while (!tf_buffer_.canTransform(options_.odom_frame, options_.base_frame, stamp)) {
-    // tf2's own timeout runs on ROS time, which stands still in lockstep: the wall clock bounds the wait.
-    if (ros::WallTime::now() >= deadline || !ros::ok()) return false;
-    ros::WallDuration(0.0005).sleep();
-  }
-  return true;
+  return waitOnWallClock([&] { return tf_buffer_.canTransform(options_.odom_frame, options_.base_frame, stamp); },
+                         options_.lockstep ? options_.tf_wait_wall : 0.0);
 }
 
 void Mapper::reportLockstep(const ros::Time& stamp) {
-  hidden_rooms::LockstepAck ack;
-  ack.node = ros::this_node::getName();
-  ack.stamp = stamp;
+  hidden_rooms::LockstepAck ack = lockstepReport(stamp);
   ack.map_stamp = last_map_stamp_;
   {
     std::lock_guard<std::mutex> lock(transform_mutex_);
-    ack.transform_stamp = last_tf_sent_;
+    if (!last_tf_stamp_.isZero()) ack.transform_stamp = last_tf_stamp_ + ros::Duration(options_.transform_tolerance);
   }
   lockstep_publisher_.publish(ack);
 }
@@ -209,8 +202,8 @@ void Mapper::publishTransform(const ros::Time& stamp) {
   if (!map_to_odom_) return;             // no scan processed yet
   if (stamp <= last_tf_stamp_) return;  // time has not moved (simulated clock slower than the timer)
   last_tf_stamp_ = stamp;
-  last_tf_sent_ = stamp + ros::Duration(options_.transform_tolerance);
-  tf_broadcaster_.sendTransform(toTransform(*map_to_odom_, options_.map_frame, options_.odom_frame, last_tf_sent_));
+  tf_broadcaster_.sendTransform(toTransform(*map_to_odom_, options_.map_frame, options_.odom_frame,
+                                            stamp + ros::Duration(options_.transform_tolerance)));
 }
 
 void Mapper::onTimer(const ros::TimerEvent&) { publishTransform(ros::Time::now()); }

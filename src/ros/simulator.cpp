@@ -12,6 +12,7 @@
 #include "hidden_rooms/common/input_error.h"
 #include "hidden_rooms/common/occupancy_grid.h"
 #include "hidden_rooms/ros/conversions.h"
+#include "hidden_rooms/ros/lockstep.h"
 #include "hidden_rooms/ros/parameters.h"
 #include "hidden_rooms/world/environment.h"
 
@@ -77,14 +78,15 @@ bool readPose(const ros::NodeHandle& nh, const std::string& name, common::Pose2*
 // "a, b" -> the names resolved in the node's namespace ({"/a", "/b"}). Throws InputError for an invalid name.
 std::vector<std::string> resolvedNodeNames(const std::string& list) {
   std::vector<std::string> names;
-  for (const std::string& name : common::splitList(list)) {
-    if (name.empty()) continue;
-    std::string problem;
-    if (!ros::names::validate(name, problem))
-      throw common::InputError("~lockstep_nodes", "'" + name + "' is not a node name: " + problem);
-    names.push_back(ros::names::resolve(name));
-  }
+  for (const std::string& name : common::splitList(list))
+    if (!name.empty()) names.push_back(resolvedNodeName(name, "lockstep_nodes"));
   return names;
+}
+
+std::string joined(const std::vector<std::string>& names) {
+  std::string text;
+  for (const std::string& name : names) text += (text.empty() ? "" : ", ") + name;
+  return text;
 }
 
 uint64_t periodInSteps(double rate, double physics_step, const std::string& name) {
@@ -215,9 +217,7 @@ Simulator::Simulator(ros::NodeHandle nh, const SimulatorOptions& options) : opti
   lockstep_nodes_ = resolvedNodeNames(options.lockstep_nodes);
   if (!lockstep_nodes_.empty()) {
     lockstep_subscriber_ = nh.subscribe("lockstep", 100, &Simulator::onLockstepAck, this);
-    std::string names;
-    for (const std::string& name : lockstep_nodes_) names += (names.empty() ? "" : ", ") + name;
-    ROS_INFO("simulator: lockstep with %s: each scan waits for their reports on %s", names.c_str(),
+    ROS_INFO("simulator: lockstep with %s: each scan waits for their reports on %s", joined(lockstep_nodes_).c_str(),
              lockstep_subscriber_.getTopic().c_str());
   }
   footprint_publisher_ = nh.advertise<geometry_msgs::PolygonStamped>("footprint", 1, true);
@@ -299,10 +299,8 @@ void Simulator::waitForLockstep() {
   while (!missing.empty() && ros::ok()) {
     const ros::WallTime wall_now = ros::WallTime::now();
     if ((wall_now - started).toSec() > options_.lockstep_timeout) {
-      std::string names;
-      for (const std::string& name : missing) names += (names.empty() ? "" : ", ") + name;
       ROS_WARN("simulator: lockstep: no report of the scan at %.2f s from %s in %.0f s (wall); stepping on",
-               last_scan_.header.stamp.toSec(), names.c_str(), options_.lockstep_timeout);
+               last_scan_.header.stamp.toSec(), joined(missing).c_str(), options_.lockstep_timeout);
       break;
     }
     if ((wall_now - last_sent).toSec() >= 1.0) {  // a node that subscribed after the scan was sent gets it now

@@ -106,7 +106,6 @@ class Mapper {
   std::mutex transform_mutex_;
   std::optional<common::Pose2> map_to_odom_;
   ros::Time last_tf_stamp_;
-  ros::Time last_tf_sent_;  // stamp map -> odom was last broadcast with (last_tf_stamp_ + transform_tolerance)
   ros::Publisher lockstep_publisher_;
   // The tf timer's own queue and thread (declared last: the thread stops before the timer and queue go).
   ros::CallbackQueue tf_queue_;
