@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -171,6 +172,26 @@ void OutputFolder::commit() {
     if (error) throw InputError((fs::path(out_) / file.filename()).string(), "cannot be written: " + error.message());
   }
   committed_ = true;
+}
+
+std::map<std::string, double> loadParameterFile(const std::string& path) {
+  const YAML::Node root = common::loadYamlFile(path, "parameters file");
+  std::map<std::string, double> parameters;
+  if (root.IsNull()) return parameters;
+  if (!root.IsMap()) throw common::InputError(path, "parameters file must be a mapping of names to numbers");
+  for (const auto& entry : root) {
+    if (!entry.first.IsScalar()) throw common::InputError(path, "a parameter name is not a plain name");
+    const std::string name = entry.first.Scalar();
+    double value = 0.0;
+    try {
+      value = entry.second.as<double>();
+    } catch (const YAML::Exception&) {
+      throw common::InputError(path, "parameter '" + name + "' is not a number");
+    }
+    if (!std::isfinite(value)) throw common::InputError(path, "parameter '" + name + "' is not finite");
+    parameters[name] = value;
+  }
+  return parameters;
 }
 
 }  // namespace hidden_rooms::common

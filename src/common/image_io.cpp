@@ -12,6 +12,8 @@
 #include <iterator>
 #include <vector>
 
+#include <opencv2/imgproc.hpp>
+
 #include "hidden_rooms/common/file_io.h"
 #include "hidden_rooms/common/input_error.h"
 #include "hidden_rooms/common/input_limits.h"
@@ -225,6 +227,16 @@ cv::Mat readImage(const std::string& path) {
     return readNetpbm(path, data);
   }
   throw InputError(path, "not a PNG, PGM or PPM image");
+}
+
+cv::Mat1b readGreyImage(const std::string& path) {
+  const cv::Mat image = readImage(path);
+  if (image.depth() != CV_8U) throw InputError(path, "is not an 8-bit image");
+  cv::Mat1b grey;
+  if (image.channels() == 1) grey = image;
+  else if (image.channels() == 2) cv::extractChannel(image, grey, 0);  // grey + alpha
+  else cv::cvtColor(image, grey, image.channels() == 3 ? cv::COLOR_BGR2GRAY : cv::COLOR_BGRA2GRAY);
+  return grey;
 }
 
 namespace {

@@ -183,7 +183,7 @@ OccupancyGrid loadMap(const std::string& yaml_path) {
 OccupancyGrid trinary(const OccupancyGrid& grid) {
   OccupancyGrid result = grid;
   result.cells = cv::Mat_<int8_t>(grid.cells.size(), OccupancyGrid::kUnknown);
-  result.cells.setTo(OccupancyGrid::kFree, grid.cells >= 0 & grid.cells <= kSaveFreeMax);
+  result.cells.setTo(OccupancyGrid::kFree, (grid.cells >= 0) & (grid.cells <= kSaveFreeMax));
   result.cells.setTo(OccupancyGrid::kOccupied, grid.cells >= kSaveOccupiedMin);
   return result;
 }

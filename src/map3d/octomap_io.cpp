@@ -248,35 +248,6 @@ void exportOctomap(const common::OccupancyGrid& map, const cv::Mat1w& room_label
   });
 }
 
-cv::Mat1w roomLabelsFromYaml(const std::string& rooms_yaml, const common::OccupancyGrid& map) {
-  const YAML::Node root = common::loadYamlFile(rooms_yaml, "rooms file");
-  const YAML::Node rooms = root["rooms"];
-  if (!rooms || !rooms.IsSequence()) throw common::InputError(rooms_yaml, "has no 'rooms' list");
-  cv::Mat1w labels = cv::Mat1w::zeros(map.height(), map.width());
-  for (size_t k = 0; k < rooms.size(); ++k) {
-    const YAML::Node room = rooms[k];
-    const std::string where = "rooms[" + std::to_string(k) + "]";
-    try {
-      if (room["placed"] && !room["placed"].as<bool>()) continue;
-      const int label = room["label"] ? room["label"].as<int>() : static_cast<int>(k) + 1;
-      if (label <= 0 || label > 65535) throw common::InputError(rooms_yaml, where + ".label is out of range");
-      std::vector<cv::Point> polygon;
-      for (const YAML::Node& vertex : room["polygon"]) {
-        const common::Point2 point(vertex[0].as<double>(), vertex[1].as<double>());
-        if (!point.allFinite()) throw common::InputError(rooms_yaml, where + " has a non-finite vertex");
-        const common::Point2 image = map.toImage(point);
-        polygon.emplace_back(static_cast<int>(std::lround(image.x() - 0.5)),
-                             static_cast<int>(std::lround(image.y() - 0.5)));
-      }
-      if (polygon.size() < 3) throw common::InputError(rooms_yaml, where + " needs a polygon of at least 3 vertices");
-      cv::fillPoly(labels, std::vector<std::vector<cv::Point>>{polygon}, cv::Scalar(label));
-    } catch (const YAML::Exception& error) {
-      throw common::InputError(rooms_yaml, where + " is malformed: " + error.msg);
-    }
-  }
-  return labels;
-}
-
 common::OccupancyGrid sliceOctomap(const std::string& path, const SliceOptions& options) {
   if (!std::isfinite(options.z_min) || !std::isfinite(options.z_max) || options.z_min >= options.z_max)
     throw common::InputError("octomap slice", "the band needs z_min < z_max");

@@ -1,12 +1,9 @@
 #include "hidden_rooms/prediction/room_predictor.h"
 
-#include <yaml-cpp/yaml.h>
-
 #include <cmath>
 #include <functional>
 #include <set>
 
-#include "hidden_rooms/common/file_io.h"
 #include "hidden_rooms/common/input_error.h"
 #include "hidden_rooms/prediction/baselines.h"
 #include "hidden_rooms/prediction/default_predictor.h"
@@ -42,26 +39,6 @@ const std::set<std::string>& namesReadByAnyMethod() {
 }
 
 }  // namespace
-
-std::map<std::string, double> loadParameterFile(const std::string& path) {
-  const YAML::Node root = common::loadYamlFile(path, "parameters file");
-  std::map<std::string, double> parameters;
-  if (root.IsNull()) return parameters;
-  if (!root.IsMap()) throw common::InputError(path, "parameters file must be a mapping of names to numbers");
-  for (const auto& entry : root) {
-    if (!entry.first.IsScalar()) throw common::InputError(path, "a parameter name is not a plain name");
-    const std::string name = entry.first.Scalar();
-    double value = 0.0;
-    try {
-      value = entry.second.as<double>();
-    } catch (const YAML::Exception&) {
-      throw common::InputError(path, "parameter '" + name + "' is not a number");
-    }
-    if (!std::isfinite(value)) throw common::InputError(path, "parameter '" + name + "' is not finite");
-    parameters[name] = value;
-  }
-  return parameters;
-}
 
 std::map<std::string, double> resolveParameters(const RoomPredictor& method,
                                                 const std::map<std::string, double>& overrides) {

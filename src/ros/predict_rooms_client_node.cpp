@@ -8,6 +8,7 @@
 #include <ros/ros.h>
 
 #include "hidden_rooms/common/command_line.h"
+#include "hidden_rooms/common/file_io.h"
 #include "hidden_rooms/common/input_error.h"
 #include "hidden_rooms/evaluation/prediction_output.h"
 #include "hidden_rooms/prediction/room_predictor.h"
@@ -46,7 +47,7 @@ int run(int argc, char** argv) {
   // Read and check the files before asking the node anything.
   prediction::PredictionRequest request;
   request.doors = common::loadDoors(doors_path);
-  if (!params_path.empty()) request.parameters = prediction::loadParameterFile(params_path);
+  if (!params_path.empty()) request.parameters = common::loadParameterFile(params_path);
   if (!map_path.empty()) request.map = common::loadMap(map_path);
 
   ros::NodeHandle nh;

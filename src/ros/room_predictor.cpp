@@ -7,6 +7,7 @@
 #include <boost/make_shared.hpp>
 #include <visualization_msgs/MarkerArray.h>
 
+#include "hidden_rooms/common/file_io.h"
 #include "hidden_rooms/common/input_error.h"
 #include "hidden_rooms/common/input_limits.h"
 #include "hidden_rooms/map3d/octomap_io.h"
@@ -65,7 +66,7 @@ RoomPredictorNode::RoomPredictorNode(ros::NodeHandle nh, const RoomPredictorOpti
   const std::unique_ptr<prediction::RoomPredictor> method = prediction::makeRoomPredictor(options_.method);
   if (!options_.closed_doors_file.empty()) default_doors_ = common::loadDoors(options_.closed_doors_file);
   if (!options_.params_file.empty()) {
-    file_parameters_ = prediction::loadParameterFile(options_.params_file);
+    file_parameters_ = common::loadParameterFile(options_.params_file);
     prediction::resolveParameters(*method, file_parameters_);  // throws for a name no method reads
   }
   method_ = options_.method;

@@ -124,7 +124,7 @@ int run(int argc, char** argv) {
   for (const std::string& name : common::splitList(methods_text))
     if (!name.empty()) methods.push_back(prediction::makeRoomPredictor(name));
   std::map<std::string, double> parameters;
-  if (!params_path.empty()) parameters = prediction::loadParameterFile(params_path);
+  if (!params_path.empty()) parameters = common::loadParameterFile(params_path);
   try {  // unknown names fail up front
     for (const auto& method : methods) prediction::resolveParameters(*method, parameters);
   } catch (const common::InputError& error) {

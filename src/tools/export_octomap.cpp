@@ -3,6 +3,7 @@
 #include <iostream>
 
 #include "hidden_rooms/common/command_line.h"
+#include "hidden_rooms/common/label_image.h"
 #include "hidden_rooms/map3d/octomap_io.h"
 
 namespace po = boost::program_options;
@@ -32,7 +33,7 @@ int run(int argc, char** argv) {
           options, positional, &values))
     return common::kExitOk;
   const common::OccupancyGrid map = common::loadMap(map_path);
-  const cv::Mat1w labels = rooms_path.empty() ? cv::Mat1w() : map3d::roomLabelsFromYaml(rooms_path, map);
+  const cv::Mat1w labels = rooms_path.empty() ? cv::Mat1w() : common::roomLabelsFromYaml(rooms_path, map);
   map3d::exportOctomap(map, labels, extrusion, out_path);
   std::cout << "export_octomap: " << map.width() << "x" << map.height() << " map, " << extrusion.height
             << " m high -> " << out_path << std::endl;

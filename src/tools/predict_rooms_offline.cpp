@@ -43,7 +43,7 @@ int run(int argc, char** argv) {
   prediction::PredictionRequest request;
   request.map = common::loadMap(map_path);
   request.doors = common::loadDoors(doors_path);
-  if (!params_path.empty()) request.parameters = prediction::loadParameterFile(params_path);
+  if (!params_path.empty()) request.parameters = common::loadParameterFile(params_path);
   request.debug_dir = debug_dir;
   cv::Mat truth;
   if (!gt_path.empty()) truth = evaluation::loadTrueRooms(gt_path, request.map);

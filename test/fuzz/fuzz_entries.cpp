@@ -6,6 +6,7 @@
 #include <fstream>
 
 #include "hidden_rooms/common/doors_file.h"
+#include "hidden_rooms/common/file_io.h"
 #include "hidden_rooms/common/image_io.h"
 #include "hidden_rooms/common/input_error.h"
 #include "hidden_rooms/common/occupancy_grid.h"
@@ -67,7 +68,7 @@ void doorsYaml(const uint8_t* data, size_t size) {
 void parameterFile(const uint8_t* data, size_t size) {
   const std::string path = scratchFile("params.yaml", text(data, size));
   refusingOnlyWithInputError([&] {
-    prediction::resolveParameters(*prediction::makeRoomPredictor("default"), prediction::loadParameterFile(path));
+    prediction::resolveParameters(*prediction::makeRoomPredictor("default"), common::loadParameterFile(path));
   });
 }
 

@@ -124,23 +124,6 @@ TEST(OctomapIo, PredictionOnASlicedMapEqualsPredictionOnTheMap) {
   EXPECT_EQ(cv::countNonZero(labels_map != labels_slice), 0);
 }
 
-TEST(OctomapIo, RoomsYamlBecomesLabels) {
-  common::OccupancyGrid map;
-  map.resolution = 0.1;
-  map.cells = cv::Mat_<int8_t>(50, 50, common::OccupancyGrid::kUnknown);
-  const std::string dir = testing::makeTempDir("octomap_rooms_yaml");
-  std::ofstream(dir + "/rooms.yaml") << "rooms:\n"
-                                        "  - {door_id: 4, label: 2, placed: true, polygon: [[1, 1], [2, 1], [2, 2], [1, 2]]}\n"
-                                        "  - {door_id: 5, label: 1, placed: false, polygon: []}\n";
-  const cv::Mat1w labels = roomLabelsFromYaml(dir + "/rooms.yaml", map);
-  EXPECT_EQ(cv::countNonZero(labels == 2), 11 * 11);  // corners on cell centres: 1.05 .. 2.05 inclusive
-  EXPECT_EQ(cv::countNonZero(labels == 1), 0);
-  std::ofstream(dir + "/bad.yaml") << "rooms:\n  - {label: 1, polygon: [[1, 1], [2, x]]}\n";
-  EXPECT_THROW(roomLabelsFromYaml(dir + "/bad.yaml", map), common::InputError);
-  std::ofstream(dir + "/none.yaml") << "method: default\n";
-  EXPECT_THROW(roomLabelsFromYaml(dir + "/none.yaml", map), common::InputError);
-}
-
 TEST(OctomapIo, BadInputGivesClearErrors) {
   const std::string dir = testing::makeTempDir("octomap_bad");
   EXPECT_NE(inputErrorMessage([&] { sliceOctomap(dir + "/missing.bt", SliceOptions()); }).find("no such file"),

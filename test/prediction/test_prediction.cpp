@@ -8,6 +8,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "hidden_rooms/common/file_io.h"
 #include "hidden_rooms/common/input_error.h"
 #include "hidden_rooms/common/input_limits.h"
 #include "hidden_rooms/common/label_image.h"
@@ -67,7 +68,7 @@ TEST(Prediction, ParametersAreResolvedPerMethod) {
 }
 
 TEST(Prediction, ShippedParameterFileEqualsTheDefaults) {
-  const auto file = loadParameterFile(std::string(HIDDEN_ROOMS_SOURCE_DIR) + "/config/prediction.yaml");
+  const auto file = common::loadParameterFile(std::string(HIDDEN_ROOMS_SOURCE_DIR) + "/config/prediction.yaml");
   std::map<std::string, double> defaults;
   for (const std::string& name : roomPredictorNames())
     for (const auto& [key, value] : makeRoomPredictor(name)->defaultParameters())

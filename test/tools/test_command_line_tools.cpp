@@ -28,6 +28,7 @@ const std::string kGenerate = GENERATE_WORLD_BIN;
 const std::string kPredict = PREDICT_ROOMS_OFFLINE_BIN;
 const std::string kExport = EXPORT_OCTOMAP_BIN;
 const std::string kSlice = SLICE_OCTOMAP_BIN;
+const std::string kSegment = SEGMENT_ROOMS_BIN;
 
 std::string writeSynthetic(const std::string& dir, const std::string& xml) {
   const std::string path = dir + "/world.xml";
@@ -259,6 +260,51 @@ TEST(PredictRoomsOfflineTool, BadInputGivesAClearErrorAndWritesNothing) {
   EXPECT_EQ(testing::fileNames(dir + "/blocked"), std::vector<std::string>{"map.pgm"});
 }
 
+TEST(SegmentRoomsTool, SegmentsAPredictedCaseIntoRoomsGraphAndEnvironment) {
+  const std::string dir = testing::makeTempDir("segment_tool");
+  const std::string input = syntheticCase(dir);
+  ASSERT_EQ(runCommand(kPredict + " --map " + input + "/map.yaml --doors " + input + "/doors.yaml --method default" +
+                       " --out " + dir + "/prediction").exit_code, 0);
+  const auto result = runCommand(kSegment + " " + input + "/map.yaml --doors " + input + "/doors.yaml --rooms " + dir +
+                                 "/prediction/rooms.yaml --out " + dir + "/out");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_NE(result.output.find("1 predicted"), std::string::npos) << result.output;
+  EXPECT_EQ(testing::fileNames(dir + "/out"),
+            (std::vector<std::string>{"preview.png", "rooms.png", "rooms.xml", "rooms.yaml"}));
+  const YAML::Node rooms = YAML::LoadFile(dir + "/out/rooms.yaml");
+  const cv::Mat labels = cv::imread(dir + "/out/rooms.png", cv::IMREAD_UNCHANGED);
+  const common::OccupancyGrid map = common::loadMap(input + "/map.yaml");
+  ASSERT_EQ(labels.size(), map.cells.size());
+  double max_label = 0.0;
+  cv::minMaxLoc(labels, nullptr, &max_label);
+  EXPECT_EQ(max_label, static_cast<double>(rooms["rooms"].size()));
+  bool predicted_door = false;
+  for (const YAML::Node& passage : rooms["passages"])
+    predicted_door |= passage["kind"].as<std::string>() == "predicted" && passage["door_id"].as<int>() == 1;
+  EXPECT_TRUE(predicted_door);
+  // The environment XML reads back with the package's own reader.
+  const auto rendered = runCommand(kRender + " " + dir + "/out/rooms.xml --out " + dir + "/rendered");
+  EXPECT_EQ(rendered.exit_code, 0) << rendered.output;
+}
+
+TEST(SegmentRoomsTool, BadInputGivesAClearErrorAndWritesNothing) {
+  const std::string dir = testing::makeTempDir("segment_tool_errors");
+  const std::string input = syntheticCase(dir);
+  std::ofstream(dir + "/far_doors.yaml") << "doors:\n- {id: 3, position: [90.0, 4.0], width: 0.9, orientation: O}\n";
+  std::ofstream(dir + "/typo.yaml") << "pasage_ratio: 0.5\n";
+  const std::string base = kSegment + " " + input + "/map.yaml --out " + dir + "/out";
+  expectBadInput(base + " --doors " + dir + "/far_doors.yaml", "door 3 at (90, 4) lies outside the map");
+  expectBadInput(base + " --method watershed", "unknown segmentation method 'watershed'");
+  expectBadInput(base + " --params " + dir + "/typo.yaml", "no segmentation method reads 'pasage_ratio'");
+  expectBadInput(base + " --rooms " + dir + "/absent.yaml", "absent.yaml");
+  expectBadInput(kSegment + " " + dir + "/absent.yaml --out " + dir + "/out", "absent.yaml: cannot open map yaml");
+  common::OccupancyGrid walls = common::loadMap(input + "/map.yaml");
+  walls.cells.setTo(common::OccupancyGrid::kOccupied);
+  common::saveMap(walls, dir + "/walls");
+  expectBadInput(kSegment + " " + dir + "/walls.yaml --out " + dir + "/out", "has no free cell");
+  EXPECT_FALSE(std::filesystem::exists(dir + "/out"));
+}
+
 // Oversized inputs, each tool run with its address space limited to 2 GB: exit 2 and a message naming the limit
 // (before, an image declaring 1e10 pixels aborted the map readers, --height 100 took 23 GB, 5000 doors 4.8 GB).
 TEST(Tools, OversizedInputsAreRefusedWithinTwoGigabytes) {
@@ -432,6 +478,7 @@ TEST(Tools, HelpExitsZero) {
   EXPECT_EQ(runCommand(kRender + " --help").exit_code, 0);
   EXPECT_EQ(runCommand(kGenerate + " --help").exit_code, 0);
   EXPECT_EQ(runCommand(kPredict + " --help").exit_code, 0);
+  EXPECT_EQ(runCommand(kSegment + " --help").exit_code, 0);
 }
 
 }  // namespace

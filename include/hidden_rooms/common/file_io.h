@@ -4,6 +4,7 @@
 // opened, InputError(path, "malformed YAML: ...") when YAML does not parse. Writing output files atomically.
 
 #include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -18,6 +19,10 @@ bool isFolder(const std::string& path);
 
 std::string readTextFile(const std::string& path, const std::string& what);
 YAML::Node loadYamlFile(const std::string& path, const std::string& what);
+// Reads a parameters file: a flat YAML mapping of parameter names to numbers (config/layout.yaml,
+// config/prediction.yaml and config/segmentation.yaml are such files). Throws InputError naming the file and the
+// problem.
+std::map<std::string, double> loadParameterFile(const std::string& path);
 
 // Writes `path` so that no reader (and no killed run) ever leaves a partial file there: `write` fills a temporary
 // file beside it, which then replaces `path` in one rename. When `write` throws or the rename fails, the

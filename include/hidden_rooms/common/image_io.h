@@ -13,6 +13,8 @@ namespace hidden_rooms::common {
 // Netpbm PGM / PPM (P2, P3, P5, P6; maxval above 255 gives 16 bits), chosen by the file's magic bytes.
 // Throws InputError naming the file: missing, unreadable, not one of these formats, truncated, empty.
 cv::Mat readImage(const std::string& path);
+// The same, as 8-bit grey: colour by its luma, an alpha channel dropped. Throws InputError also for 16-bit images.
+cv::Mat1b readGreyImage(const std::string& path);
 
 // Writes a PNG (extension .png: CV_8UC1, CV_16UC1, CV_8UC2, CV_8UC3 BGR, CV_8UC4 BGRA, CV_16UC3) or a binary PGM
 // (extension .pgm: CV_8UC1, CV_16UC1). Throws InputError naming the file when the extension or pixel type is not

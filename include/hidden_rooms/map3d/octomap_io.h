@@ -25,10 +25,6 @@ struct ExtrusionOptions {
 void exportOctomap(const common::OccupancyGrid& map, const cv::Mat1w& room_labels, const ExtrusionOptions& options,
                    const std::string& path);
 
-// The label image of a prediction's rooms.yaml (predict_rooms_offline, predict_rooms_client) in `map`'s grid:
-// each placed room's polygon filled with its label. Throws InputError for a missing or malformed file.
-cv::Mat1w roomLabelsFromYaml(const std::string& rooms_yaml, const common::OccupancyGrid& map);
-
 struct SliceOptions {
   double z_min = 0.1;       // metres: the height band projected to 2D
   double z_max = 2.0;

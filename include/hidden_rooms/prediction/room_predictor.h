@@ -60,10 +60,6 @@ class RoomPredictor {
 std::map<std::string, double> resolveParameters(const RoomPredictor& method,
                                                 const std::map<std::string, double>& overrides);
 
-// Reads a parameters file: a flat YAML mapping of parameter names to numbers (config/layout.yaml and
-// config/prediction.yaml are such files). Throws InputError naming the file and the problem.
-std::map<std::string, double> loadParameterFile(const std::string& path);
-
 // The registered methods, e.g. {"skewnormal", "structured", "unstructured"}.
 std::vector<std::string> roomPredictorNames();
 // Throws InputError naming the method and the known ones when `name` is not registered.

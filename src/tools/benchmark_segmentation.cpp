@@ -1,0 +1,218 @@
+// benchmark_segmentation [--survey-maps DIR] [--environments DIR] --methods A,B [options]: scores room segmentation
+// methods against ground truth with the survey's per-room recall and precision and Matthews' correlation
+// coefficient, and times them. Survey maps: DIR/NAME.png (free: pixels above 250, as the survey reads them) with
+// DIR/NAME_gt_segmentation.png; environments: every *.xml under DIR rendered with its doors open, the spaces as
+// ground truth.
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <map>
+#include <set>
+#include <vector>
+
+#include "hidden_rooms/common/command_line.h"
+#include "hidden_rooms/common/file_io.h"
+#include "hidden_rooms/common/image_io.h"
+#include "hidden_rooms/common/input_error.h"
+#include "hidden_rooms/common/label_image.h"
+#include "hidden_rooms/segmentation/room_segmenter.h"
+#include "hidden_rooms/segmentation/segmentation_metrics.h"
+#include "hidden_rooms/world/environment.h"
+#include "hidden_rooms/world/render.h"
+
+namespace po = boost::program_options;
+namespace fs = std::filesystem;
+using namespace hidden_rooms;
+
+namespace {
+
+struct Case {
+  std::string name;
+  segmentation::SegmentationInput input;
+  cv::Mat1w truth;
+};
+
+constexpr double kSurveyResolution = 0.05;  // metres per pixel of the survey's maps
+
+std::vector<std::string> sortedFiles(const std::string& folder, const std::string& suffix, bool recursive) {
+  if (!common::isFolder(folder)) throw common::InputError(folder, "is not a folder");
+  std::vector<std::string> files;
+  const auto take = [&](const fs::directory_entry& entry) {
+    const std::string path = entry.path().string();
+    if (entry.is_regular_file() && path.size() > suffix.size() &&
+        path.compare(path.size() - suffix.size(), suffix.size(), suffix) == 0)
+      files.push_back(path);
+  };
+  if (recursive) for (const auto& entry : fs::recursive_directory_iterator(folder)) take(entry);
+  else for (const auto& entry : fs::directory_iterator(folder)) take(entry);
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+std::vector<Case> surveyCases(const std::string& folder) {
+  std::vector<Case> cases;
+  const std::string suffix = "_gt_segmentation.png";
+  for (const std::string& truth_path : sortedFiles(folder, suffix, false)) {
+    const std::string map_path = truth_path.substr(0, truth_path.size() - suffix.size()) + ".png";
+    Case each;
+    each.name = fs::path(map_path).stem().string();
+    const cv::Mat1b map = common::readGreyImage(map_path);
+    const cv::Mat1b truth = common::readGreyImage(truth_path);
+    if (map.size() != truth.size()) throw common::InputError(truth_path, "differs in size from " + map_path);
+    each.input.free = map > 250;  // the survey's free pixels: white
+    each.input.resolution = kSurveyResolution;
+    each.truth = segmentation::roomsFromBorderImage(truth);
+    cases.push_back(each);
+  }
+  if (cases.empty()) throw common::InputError(folder, "holds no NAME_gt_segmentation.png");
+  return cases;
+}
+
+std::vector<Case> environmentCases(const std::string& folder) {
+  std::vector<Case> cases;
+  for (const std::string& path : sortedFiles(folder, ".xml", true)) {
+    const world::Environment environment = world::loadEnvironment(path);
+    const world::RenderedEnvironment rendered = world::renderEnvironment(environment, {});
+    Case each;
+    each.name = fs::path(path).stem().string();
+    each.input.free = rendered.map.cells == common::OccupancyGrid::kFree;
+    each.input.resolution = rendered.map.resolution;
+    each.truth = rendered.space_labels;
+    cases.push_back(each);
+  }
+  if (cases.empty()) throw common::InputError(folder, "holds no environment XML");
+  return cases;
+}
+
+std::map<std::string, double> parseSettings(const std::vector<std::string>& settings) {
+  std::map<std::string, double> values;
+  for (const std::string& setting : settings) {
+    const size_t equals = setting.find('=');
+    size_t used = 0;
+    double value = 0.0;
+    try {
+      if (equals != std::string::npos) value = std::stod(setting.substr(equals + 1), &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (equals == std::string::npos || used == 0 || equals + 1 + used != setting.size())
+      throw common::InputError("--set", "'" + setting + "' is not NAME=NUMBER");
+    values[setting.substr(0, equals)] = value;
+  }
+  return values;
+}
+
+cv::Mat3b picture(const cv::Mat1b& free, const cv::Mat1w& labels) {
+  cv::Mat3b image(free.size(), cv::Vec3b(0, 0, 0));
+  for (int row = 0; row < free.rows; ++row)
+    for (int col = 0; col < free.cols; ++col)
+      if (labels(row, col) != 0) image(row, col) = common::roomColour(labels(row, col));
+      else if (free(row, col) != 0) image(row, col) = cv::Vec3b(255, 255, 255);
+  return image;
+}
+
+int run(int argc, char** argv) {
+  po::options_description options("Options");
+  std::string survey_dir, environments_dir, methods_text = "default", params_path, only_text, out_dir;
+  std::vector<std::string> settings;
+  bool per_map = false;
+  options.add_options()
+      ("survey-maps", po::value(&survey_dir), "folder of NAME.png + NAME_gt_segmentation.png (the survey's maps)")
+      ("environments", po::value(&environments_dir), "folder of environment XMLs (searched recursively)")
+      ("methods", po::value(&methods_text)->default_value(methods_text), "comma-separated segmentation methods")
+      ("params", po::value(&params_path), "parameter overrides: flat YAML of name: number")
+      ("set", po::value(&settings)->composing(), "NAME=VALUE: one parameter override (repeatable, after --params)")
+      ("only", po::value(&only_text), "comma-separated map names to score (default: all)")
+      ("per-map", po::bool_switch(&per_map), "print every map's scores, not only the means")
+      ("out", po::value(&out_dir), "folder for each map's labels (METHOD/NAME.png) and pictures (NAME_colour.png)");
+  po::variables_map values;
+  if (!common::parseCommandLine(
+          argc, argv,
+          "Usage: benchmark_segmentation [--survey-maps DIR] [--environments DIR] [--methods A,B]\n"
+          "                              [--params FILE] [--set NAME=VALUE ...] [--only NAME,...] [--per-map]\n"
+          "                              [--out DIR]\n"
+          "Scores room segmentation methods against ground truth: the survey's per-room recall and precision\n"
+          "(micro: mean over rooms, macro: pooled over cells), Matthews' correlation coefficient over pairs of\n"
+          "cells, and the seconds per map.",
+          options, {}, &values))
+    return common::kExitOk;
+  if (survey_dir.empty() && environments_dir.empty())
+    throw common::InputError("command line", "give --survey-maps and/or --environments");
+  std::map<std::string, double> overrides;
+  if (!params_path.empty()) overrides = common::loadParameterFile(params_path);
+  for (const auto& [name, value] : parseSettings(settings)) overrides[name] = value;
+  std::vector<std::unique_ptr<segmentation::RoomSegmenter>> methods;
+  for (const std::string& name : common::splitList(methods_text)) {
+    methods.push_back(segmentation::makeRoomSegmenter(name));
+    segmentation::resolveSegmenterParameters(*methods.back(), overrides);  // bad overrides fail before any work
+  }
+  const std::vector<std::string> only = common::splitList(only_text);
+
+  std::vector<Case> cases;
+  if (!survey_dir.empty()) cases = surveyCases(survey_dir);
+  if (!environments_dir.empty())
+    for (Case& each : environmentCases(environments_dir)) cases.push_back(std::move(each));
+  if (!only.empty()) {
+    for (const std::string& name : only)
+      if (std::none_of(cases.begin(), cases.end(), [&](const Case& each) { return each.name == name; }))
+        throw common::InputError("--only", "no map named '" + name + "'");
+    cases.erase(std::remove_if(cases.begin(), cases.end(),
+                               [&](const Case& each) {
+                                 return std::find(only.begin(), only.end(), each.name) == only.end();
+                               }),
+                cases.end());
+  }
+  if (!out_dir.empty()) common::createOutputDirectory(out_dir);
+
+  std::cout << std::fixed << std::setprecision(3);
+  std::cout << std::left << std::setw(16) << "method" << std::setw(24) << "map" << std::right
+            << "  rec_mi  pre_mi  rec_ma  pre_ma     mcc  rooms  found  seconds\n";
+  for (const auto& method : methods) {
+    segmentation::SegmentationScores sum;
+    std::vector<double> seconds;
+    for (const Case& each : cases) {
+      const auto start = std::chrono::steady_clock::now();
+      const cv::Mat1w labels = segmentation::segmentRooms(*method, each.input, overrides);
+      seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+      const segmentation::SegmentationScores scores = segmentation::scoreSegmentation(labels, each.truth);
+      if (!out_dir.empty()) {
+        const std::string folder = out_dir + "/" + method->name();
+        common::createOutputDirectory(folder);
+        common::saveLabelImage(labels, folder + "/" + each.name + ".png");
+        common::writeImage(folder + "/" + each.name + "_colour.png", picture(each.input.free, labels));
+      }
+      if (per_map)
+        std::cout << std::left << std::setw(16) << method->name() << std::setw(24) << each.name << std::right
+                  << std::setw(8) << scores.recall_micro << std::setw(8) << scores.precision_micro << std::setw(8)
+                  << scores.recall_macro << std::setw(8) << scores.precision_macro << std::setw(8) << scores.mcc
+                  << std::setw(7) << scores.truth_rooms << std::setw(7) << scores.found_rooms << std::setw(9)
+                  << seconds.back() << "\n";
+      sum.recall_micro += scores.recall_micro;
+      sum.precision_micro += scores.precision_micro;
+      sum.recall_macro += scores.recall_macro;
+      sum.precision_macro += scores.precision_macro;
+      sum.mcc += scores.mcc;
+      sum.truth_rooms += scores.truth_rooms;
+      sum.found_rooms += scores.found_rooms;
+    }
+    const double n = static_cast<double>(cases.size());
+    std::sort(seconds.begin(), seconds.end());
+    const double median = seconds.size() % 2 ? seconds[seconds.size() / 2]
+                                             : 0.5 * (seconds[seconds.size() / 2 - 1] + seconds[seconds.size() / 2]);
+    std::cout << std::left << std::setw(16) << method->name() << std::setw(24)
+              << ("mean of " + std::to_string(cases.size())) << std::right << std::setw(8) << sum.recall_micro / n
+              << std::setw(8) << sum.precision_micro / n << std::setw(8) << sum.recall_macro / n << std::setw(8)
+              << sum.precision_macro / n << std::setw(8) << sum.mcc / n << std::setw(7) << sum.truth_rooms
+              << std::setw(7) << sum.found_rooms << std::setw(9) << median << "  (median s)\n";
+    std::cout << std::flush;
+  }
+  return common::kExitOk;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return common::runTool("benchmark_segmentation", [&] { return run(argc, argv); });
+}
