@@ -207,6 +207,55 @@ prediction::RoomPrediction fromRos(const hidden_rooms::PredictedRoom& message, c
   return room;
 }
 
+hidden_rooms::SegmentedRoom toRos(const segmentation::Room& room) {
+  hidden_rooms::SegmentedRoom message;
+  message.label = static_cast<uint32_t>(room.label);
+  message.kind = room.kind == segmentation::RoomKind::kCorridor ? hidden_rooms::SegmentedRoom::CORRIDOR
+                                                                : hidden_rooms::SegmentedRoom::ROOM;
+  message.type = room.type;
+  message.predicted = room.predicted;
+  message.area = room.area;
+  message.width = room.width;
+  message.centroid = toRos(room.centroid, 0.0);
+  for (const common::Point2& vertex : room.outline) message.outline.push_back(toRos(vertex, 0.0));
+  return message;
+}
+
+hidden_rooms::RoomPassage toRos(const segmentation::Passage& passage) {
+  hidden_rooms::RoomPassage message;
+  message.room_a = static_cast<uint32_t>(passage.room_a);
+  message.room_b = static_cast<uint32_t>(passage.room_b);
+  switch (passage.kind) {
+    case segmentation::PassageKind::kOpen: message.kind = hidden_rooms::RoomPassage::OPEN; break;
+    case segmentation::PassageKind::kClosed: message.kind = hidden_rooms::RoomPassage::CLOSED; break;
+    case segmentation::PassageKind::kPredicted: message.kind = hidden_rooms::RoomPassage::PREDICTED; break;
+  }
+  message.door_id = passage.door_id;
+  message.centre = toRos(passage.centre, 0.0);
+  message.width = passage.width;
+  return message;
+}
+
+sensor_msgs::Image labelsToRos(const cv::Mat1w& labels, const std::string& frame_id, const ros::Time& stamp) {
+  sensor_msgs::Image message;
+  message.header.frame_id = frame_id;
+  message.header.stamp = stamp;
+  message.width = static_cast<uint32_t>(labels.cols);
+  message.height = static_cast<uint32_t>(labels.rows);
+  message.encoding = "mono16";
+  message.is_bigendian = false;
+  message.step = message.width * 2;
+  message.data.resize(static_cast<size_t>(message.step) * message.height);
+  for (int row = 0; row < labels.rows; ++row)
+    for (int col = 0; col < labels.cols; ++col) {
+      const uint16_t label = labels(labels.rows - 1 - row, col);
+      const size_t at = static_cast<size_t>(row) * message.step + 2 * static_cast<size_t>(col);
+      message.data[at] = static_cast<uint8_t>(label & 0xff);
+      message.data[at + 1] = static_cast<uint8_t>(label >> 8);
+    }
+  return message;
+}
+
 common::VelocityCommand fromRos(const geometry_msgs::Twist& message) { return {message.linear.x, message.angular.z}; }
 
 geometry_msgs::Twist toRos(const common::VelocityCommand& command) {

@@ -165,6 +165,55 @@ visualization_msgs::MarkerArray toMarkers(const common::OccupancyGrid& map, cons
   return array;
 }
 
+visualization_msgs::MarkerArray toMarkers(const segmentation::SegmentedFloor& floor, const std::string& frame_id,
+                                          const ros::Time& stamp) {
+  using visualization_msgs::Marker;
+  visualization_msgs::MarkerArray array = startArray(frame_id, stamp);
+  Marker nodes = newMarker("room_nodes", 0, Marker::SPHERE_LIST, frame_id, stamp);
+  nodes.scale.x = nodes.scale.y = nodes.scale.z = 0.4;
+  for (const segmentation::Room& room : floor.rooms) {
+    const double alpha = room.predicted ? 0.5 : 1.0;
+    if (room.outline.size() >= 2) {
+      Marker outline = newMarker("room_outlines", room.label, Marker::LINE_STRIP, frame_id, stamp);
+      outline.scale.x = 0.08;
+      outline.color = roomColourRgba(room.label, alpha);
+      for (const common::Point2& vertex : room.outline) outline.points.push_back(toRos(vertex, 0.03));
+      outline.points.push_back(outline.points.front());
+      array.markers.push_back(outline);
+    }
+    Marker text = newMarker("room_labels", room.label, Marker::TEXT_VIEW_FACING, frame_id, stamp);
+    text.pose.position = toRos(room.centroid, 0.8);
+    text.scale.z = 0.7;  // metres: text height
+    char area[32];
+    std::snprintf(area, sizeof(area), "%.1f m2", room.area);
+    text.text = std::to_string(room.label) + " " + (room.predicted ? "predicted " : "") +
+                (room.type.empty() ? segmentation::toString(room.kind) : room.type) + "\n" + area;
+    array.markers.push_back(text);
+    nodes.points.push_back(toRos(room.centroid, 0.3));
+    nodes.colors.push_back(roomColourRgba(room.label, alpha));
+  }
+  if (!nodes.points.empty()) array.markers.push_back(nodes);
+  const std::pair<segmentation::PassageKind, std_msgs::ColorRGBA> kinds[] = {
+      {segmentation::PassageKind::kOpen, colour(0.1, 0.7, 0.1, 1.0)},
+      {segmentation::PassageKind::kClosed, colour(0.9, 0.1, 0.1, 1.0)},
+      {segmentation::PassageKind::kPredicted, colour(1.0, 0.55, 0.0, 1.0)}};
+  for (const auto& [kind, edge_colour] : kinds) {
+    Marker edges = newMarker("room_graph", static_cast<int>(kind), Marker::LINE_LIST, frame_id, stamp);
+    edges.scale.x = 0.06;
+    edges.color = edge_colour;
+    for (const segmentation::Passage& passage : floor.passages) {
+      if (passage.kind != kind) continue;
+      for (const int label : {passage.room_a, passage.room_b}) {
+        if (label == 0) continue;
+        edges.points.push_back(toRos(floor.rooms[label - 1].centroid, 0.3));
+        edges.points.push_back(toRos(passage.centre, 0.3));
+      }
+    }
+    if (!edges.points.empty()) array.markers.push_back(edges);
+  }
+  return array;
+}
+
 visualization_msgs::MarkerArray toDebugMarkers(const common::OccupancyGrid& map, const prediction::Layout& layout,
                                                const std::string& frame_id, const ros::Time& stamp) {
   using visualization_msgs::Marker;

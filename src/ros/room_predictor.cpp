@@ -1,6 +1,7 @@
 #include "hidden_rooms/ros/room_predictor.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 
@@ -45,6 +46,11 @@ const common::OptionTable<RoomPredictorOptions>& roomPredictorNodeOptionTable() 
       {"click_search_radius", &O::click_search_radius, "metres around a click where the door's wall is looked for",
        common::above(0)},
       {"view_frame", &O::view_frame, "tf frame at the centre of the map's known cells, for rviz's view"},
+      {"segmentation_method", &O::segmentation_method, "segmentation method of segment_rooms requests that name none"},
+      {"segmentation_params_file", &O::segmentation_params_file,
+       "flat `name: number` overrides of the segmentation (config/segmentation.yaml)"},
+      {"segment_on_prediction", &O::segment_on_prediction,
+       "after each prediction, segment its map with the predicted rooms and publish room_segmentation"},
   };
   return table;
 }
@@ -69,6 +75,12 @@ RoomPredictorNode::RoomPredictorNode(ros::NodeHandle nh, const RoomPredictorOpti
     file_parameters_ = common::loadParameterFile(options_.params_file);
     prediction::resolveParameters(*method, file_parameters_);  // throws for a name no method reads
   }
+  const std::unique_ptr<segmentation::RoomSegmenter> segmenter =
+      segmentation::makeRoomSegmenter(options_.segmentation_method);
+  if (!options_.segmentation_params_file.empty()) {
+    segmentation_parameters_ = common::loadParameterFile(options_.segmentation_params_file);
+    segmentation::resolveSegmenterParameters(*segmenter, segmentation_parameters_);  // throws for unknown names
+  }
   method_ = options_.method;
   parameters_ = file_parameters_;
   // The live configuration starts from the node's settings (not from the .cfg's defaults).
@@ -92,6 +104,8 @@ RoomPredictorNode::RoomPredictorNode(ros::NodeHandle nh, const RoomPredictorOpti
   predicted_map_publisher_ = nh.advertise<nav_msgs::OccupancyGrid>("predicted_map", 1, true);
   markers_publisher_ = nh.advertise<visualization_msgs::MarkerArray>("predicted_rooms", 1, true);
   service_ = nh.advertiseService("predict_rooms", &RoomPredictorNode::predictRooms, this);
+  segmentation_publisher_ = nh.advertise<visualization_msgs::MarkerArray>("room_segmentation", 1, true);
+  segmentation_service_ = nh.advertiseService("segment_rooms", &RoomPredictorNode::segmentRooms, this);
   map_subscriber_ = nh.subscribe("map", 1, &RoomPredictorNode::receiveMap, this);
   save_doors_service_ = nh.advertiseService("save_doors", &RoomPredictorNode::saveDoors, this);
   if (options_.doors_from_clicks)
@@ -285,35 +299,49 @@ bool RoomPredictorNode::predictRooms(PredictRooms::Request& request, PredictRoom
   return true;
 }
 
-void RoomPredictorNode::predict(const PredictRooms::Request& request, PredictRooms::Response* response) {
-  const bool own_map = request.map.info.width > 0 && request.map.info.height > 0;
+common::OccupancyGrid RoomPredictorNode::requestMap(const nav_msgs::OccupancyGrid& request_map,
+                                                    std::string* frame) const {
+  const bool own_map = request_map.info.width > 0 && request_map.info.height > 0;
   if (!own_map && latest_map_ == nullptr)
     throw common::InputError("map", "the request has no map and none was received on " + map_topic_ + " yet");
-  const nav_msgs::OccupancyGrid& map_message = own_map ? request.map : *latest_map_;
+  const nav_msgs::OccupancyGrid& map_message = own_map ? request_map : *latest_map_;
   const double cells = static_cast<double>(map_message.info.width) * map_message.info.height;
   if (cells > options_.max_map_cells)
     throw common::InputError("map",
                              std::to_string(map_message.info.width) + " x " + std::to_string(map_message.info.height) +
                                  " cells is more than ~max_map_cells (" + std::to_string(options_.max_map_cells) + ")");
-  if (request.doors.size() > static_cast<size_t>(options_.max_doors))
-    throw common::InputError("doors", std::to_string(request.doors.size()) + " doors is more than ~max_doors (" +
-                                          std::to_string(options_.max_doors) + ")");
-  const std::string frame = map_message.header.frame_id.empty() ? options_.frame_id : map_message.header.frame_id;
+  *frame = map_message.header.frame_id.empty() ? options_.frame_id : map_message.header.frame_id;
+  return common::trinary(fromRos(map_message));  // as map_saver would save it: results equal offline ones
+}
 
-  prediction::PredictionRequest core;
-  core.map = common::trinary(fromRos(map_message));  // as map_saver would save it: predictions equal offline ones
-  prediction::checkUsableMap(core.map);
-  if (!request.doors.empty()) {
-    core.doors = fromRos(request.doors, frame);
-  } else if (default_doors_) {
+common::DoorsFile RoomPredictorNode::requestDoors(const std::vector<ClosedDoor>& request_doors,
+                                                  const std::string& frame, bool required) const {
+  if (request_doors.size() > static_cast<size_t>(options_.max_doors))
+    throw common::InputError("doors", std::to_string(request_doors.size()) + " doors is more than ~max_doors (" +
+                                          std::to_string(options_.max_doors) + ")");
+  if (!request_doors.empty()) return fromRos(request_doors, frame);
+  if (default_doors_) {
     if (default_doors_->frame != frame)
       throw common::InputError("~closed_doors_file", "its doors are in frame '" + default_doors_->frame +
                                                          "', the map in '" + frame + "'");
-    core.doors = *default_doors_;
-  } else {
+    return *default_doors_;
+  }
+  if (required)
     throw common::InputError("doors", "the request has no doors and the node has none (no ~closed_doors_file, "
                                       "no door clicked on clicked_point)");
-  }
+  common::DoorsFile none;
+  none.frame = frame;
+  return none;
+}
+
+void RoomPredictorNode::predict(const PredictRooms::Request& request, PredictRooms::Response* response) {
+  std::string frame;
+  prediction::PredictionRequest core;
+  core.map = requestMap(request.map, &frame);
+  const nav_msgs::OccupancyGrid& map_message =
+      request.map.info.width > 0 && request.map.info.height > 0 ? request.map : *latest_map_;
+  prediction::checkUsableMap(core.map);
+  core.doors = requestDoors(request.doors, frame, true);
   if (core.doors.doors.empty()) throw common::InputError("doors", "no closed doors to predict");
   prediction::checkDoorsInsideMap(core.map, core.doors);
   core.parameters = parameters_;
@@ -357,6 +385,16 @@ void RoomPredictorNode::predict(const PredictRooms::Request& request, PredictRoo
     markers.markers.insert(markers.markers.end(), debug.markers.begin(), debug.markers.end());
   }
   markers_publisher_.publish(markers);
+  latest_prediction_labels_ = labels;
+  latest_prediction_origin_ = core.map.origin;
+  latest_prediction_resolution_ = core.map.resolution;
+  if (options_.segment_on_prediction) {
+    try {
+      segment(core.map, core.doors, labels, options_.segmentation_method, frame);
+    } catch (const common::InputError& error) {
+      ROS_WARN("room_predictor: the prediction's map was not segmented: %s", error.what());
+    }
+  }
 
   if (!options_.octomap_out.empty()) {
     map3d::ExtrusionOptions extrusion;
@@ -368,6 +406,60 @@ void RoomPredictorNode::predict(const PredictRooms::Request& request, PredictRoo
       response->message += "; but the 3D map was not written: " + std::string(error.what());
     }
   }
+}
+
+bool RoomPredictorNode::segmentRooms(SegmentRooms::Request& request, SegmentRooms::Response& response) {
+  response = SegmentRooms::Response();
+  try {
+    std::string frame;
+    const common::OccupancyGrid map = requestMap(request.map, &frame);
+    const common::DoorsFile doors = requestDoors(request.doors, frame, false);
+    cv::Mat1w predicted;
+    if (request.with_predicted_rooms) {
+      if (latest_prediction_labels_.empty())
+        throw common::InputError("with_predicted_rooms", "the node has predicted no rooms yet");
+      if (latest_prediction_labels_.size() != map.cells.size() || latest_prediction_origin_ != map.origin ||
+          latest_prediction_resolution_ != map.resolution)
+        throw common::InputError("with_predicted_rooms", "the latest prediction was made on another map");
+      predicted = latest_prediction_labels_;
+    }
+    const std::string method = request.method.empty() ? options_.segmentation_method : request.method;
+    const auto start = std::chrono::steady_clock::now();
+    const segmentation::SegmentedFloor floor = segment(map, doors, predicted, method, frame);
+    response.computation_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const ros::Time stamp = ros::Time::now();
+    response.labels = labelsToRos(floor.labels, frame, stamp);
+    int corridors = 0, predicted_rooms = 0;
+    for (const segmentation::Room& room : floor.rooms) {
+      response.rooms.push_back(toRos(room));
+      corridors += room.kind == segmentation::RoomKind::kCorridor;
+      predicted_rooms += room.predicted;
+    }
+    for (const segmentation::Passage& passage : floor.passages) response.passages.push_back(toRos(passage));
+    char summary[160];
+    std::snprintf(summary, sizeof(summary), "%zu rooms (%d corridors, %d predicted), %zu passages in %.3f s by %s",
+                  floor.rooms.size(), corridors, predicted_rooms, floor.passages.size(), response.computation_time,
+                  method.c_str());
+    response.message = summary;
+    response.success = true;
+  } catch (const std::exception& error) {  // InputError: a bad request; anything else: a bug, reported too
+    response = SegmentRooms::Response();
+    response.success = false;
+    response.message = error.what();
+  }
+  return true;
+}
+
+segmentation::SegmentedFloor RoomPredictorNode::segment(const common::OccupancyGrid& map,
+                                                        const common::DoorsFile& doors,
+                                                        const cv::Mat1w& predicted_rooms, const std::string& method,
+                                                        const std::string& frame) {
+  segmentation::FloorSegmentationOptions floor_options;
+  floor_options.method = method;
+  floor_options.parameters = segmentation_parameters_;
+  const segmentation::SegmentedFloor floor = segmentation::segmentFloor(map, doors, predicted_rooms, floor_options);
+  segmentation_publisher_.publish(toMarkers(floor, frame, ros::Time::now()));
+  return floor;
 }
 
 }  // namespace hidden_rooms

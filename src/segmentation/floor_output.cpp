@@ -3,6 +3,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <cctype>
 #include <limits>
 
 #include <opencv2/imgproc.hpp>
@@ -56,7 +57,9 @@ world::Environment floorToEnvironment(const SegmentedFloor& floor, const common:
     world::Space space;
     space.id = spaceId(room.label);
     space.type = room.kind == RoomKind::kCorridor ? "C" : "R";
-    space.label = room.predicted ? "PREDICTED ROOM" : room.kind == RoomKind::kCorridor ? "CORRIDOR" : "ROOM";
+    std::string label = room.type.empty() ? "ROOM" : room.type;
+    std::transform(label.begin(), label.end(), label.begin(), [](unsigned char c) { return std::toupper(c); });
+    space.label = room.predicted ? "PREDICTED " + label : label;
     for (const common::Point2& vertex : room.outline) space.outline.push_back(local(vertex));
     for (size_t i = 0; i < space.outline.size(); ++i) {
       world::LineSegment wall;
@@ -103,6 +106,7 @@ std::string floorToYaml(const SegmentedFloor& floor) {
     out << YAML::BeginMap;
     out << YAML::Key << "label" << YAML::Value << room.label;
     out << YAML::Key << "kind" << YAML::Value << toString(room.kind);
+    out << YAML::Key << "type" << YAML::Value << room.type;
     out << YAML::Key << "predicted" << YAML::Value << room.predicted;
     out << YAML::Key << "area" << YAML::Value << room.area;
     out << YAML::Key << "width" << YAML::Value << room.width;

@@ -6,6 +6,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "hidden_rooms/common/input_error.h"
+#include "hidden_rooms/segmentation/room_types.h"
 
 namespace hidden_rooms::segmentation {
 
@@ -58,8 +59,7 @@ std::vector<cv::Rect> labelBoxes(const cv::Mat1w& labels, int count) {
 }
 
 // `box`: the bounding box of the room's cells.
-Room describeRoom(const common::OccupancyGrid& map, const cv::Mat1w& labels, int label, const cv::Rect& box,
-                  double corridor_elongation) {
+Room describeRoom(const common::OccupancyGrid& map, const cv::Mat1w& labels, int label, const cv::Rect& box) {
   Room room;
   room.label = label;
   // The room's cells with a one-cell empty frame, so that its border is found on every side.
@@ -75,7 +75,6 @@ Room describeRoom(const common::OccupancyGrid& map, const cv::Mat1w& labels, int
   double max_distance = 0.0;
   cv::minMaxLoc(distance, nullptr, &max_distance);
   room.width = 2.0 * max_distance * map.resolution;
-  room.kind = room.area >= corridor_elongation * room.width * room.width ? RoomKind::kCorridor : RoomKind::kRoom;
 
   std::vector<std::vector<cv::Point>> contours;
   cv::findContours(local, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_SIMPLE);
@@ -190,7 +189,7 @@ SegmentedFloor segmentFloor(const common::OccupancyGrid& map, const common::Door
   }
   const std::vector<cv::Rect> boxes = labelBoxes(floor.labels, next_label);
   for (int label = 1; label <= next_label; ++label) {
-    floor.rooms.push_back(describeRoom(map, floor.labels, label, boxes[label], options.corridor_elongation));
+    floor.rooms.push_back(describeRoom(map, floor.labels, label, boxes[label]));
     floor.rooms.back().predicted = label > explored;
   }
 
@@ -208,6 +207,7 @@ SegmentedFloor segmentFloor(const common::OccupancyGrid& map, const common::Door
     passage.kind = b > explored ? PassageKind::kPredicted : PassageKind::kClosed;
     floor.passages.push_back(passage);
   }
+  if (options.classify_rooms) classifyRooms(RoomTypeClassifier::shipped(), &floor);
   return floor;
 }
 

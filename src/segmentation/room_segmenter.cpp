@@ -19,6 +19,7 @@ const std::map<std::string, Factory>& registry() {
   static const std::map<std::string, Factory> methods = {
       {"default", [] { return std::make_unique<PassageSegmenter>(); }},
       {"morphological", [] { return std::make_unique<MorphologicalSegmenter>(); }},
+      {"voronoi", [] { return std::make_unique<VoronoiSegmenter>(); }},
   };
   return methods;
 }

@@ -98,6 +98,37 @@ SegmentationScores scoreSegmentation(const cv::Mat1w& found, const cv::Mat1w& tr
   return scores;
 }
 
+KindScores scoreRoomKinds(const cv::Mat1w& found, const std::vector<RoomKind>& found_kinds, const cv::Mat1w& truth,
+                          const std::vector<RoomKind>& truth_kinds, int min_region_cells) {
+  if (found.size() != truth.size()) throw common::InputError("segmentation", "differs in size from the ground truth");
+  std::map<int, std::map<int, int>> overlap;  // found label -> truth label -> cells
+  std::map<int, int> size;
+  for (int row = 0; row < found.rows; ++row)
+    for (int col = 0; col < found.cols; ++col) {
+      const int label = found(row, col);
+      if (label == 0) continue;
+      ++size[label];
+      if (truth(row, col) != 0) ++overlap[label][truth(row, col)];
+    }
+  KindScores scores;
+  for (const auto& [label, cells] : overlap) {
+    if (size[label] < min_region_cells) continue;
+    int best = 0;
+    for (const auto& [truth_label, count] : cells)
+      if (best == 0 || count > cells.at(best)) best = truth_label;
+    if (label > static_cast<int>(found_kinds.size()) || best > static_cast<int>(truth_kinds.size()))
+      throw common::InputError("room kinds", "label " + std::to_string(std::max(label, best)) + " has no kind");
+    const RoomKind truth_kind = truth_kinds[best - 1], found_kind = found_kinds[label - 1];
+    ++scores.rooms;
+    scores.correct += truth_kind == found_kind;
+    if (truth_kind == RoomKind::kCorridor) {
+      ++scores.corridors;
+      scores.corridors_found += found_kind == RoomKind::kCorridor;
+    }
+  }
+  return scores;
+}
+
 cv::Mat1w roomsFromBorderImage(const cv::Mat1b& image) {
   cv::Mat1i components;
   const int count = cv::connectedComponents(image > 250, components, 8, CV_32S);

@@ -17,6 +17,8 @@
 #include "hidden_rooms/common/image_io.h"
 #include "hidden_rooms/common/input_error.h"
 #include "hidden_rooms/common/label_image.h"
+#include "hidden_rooms/segmentation/floor_output.h"
+#include "hidden_rooms/segmentation/room_graph.h"
 #include "hidden_rooms/segmentation/room_segmenter.h"
 #include "hidden_rooms/segmentation/segmentation_metrics.h"
 #include "hidden_rooms/world/environment.h"
@@ -30,8 +32,9 @@ namespace {
 
 struct Case {
   std::string name;
-  segmentation::SegmentationInput input;
+  common::OccupancyGrid map;
   cv::Mat1w truth;
+  std::vector<segmentation::RoomKind> truth_kinds;  // per truth label; empty: the ground truth has no kinds
 };
 
 constexpr double kSurveyResolution = 0.05;  // metres per pixel of the survey's maps
@@ -61,8 +64,9 @@ std::vector<Case> surveyCases(const std::string& folder) {
     const cv::Mat1b map = common::readGreyImage(map_path);
     const cv::Mat1b truth = common::readGreyImage(truth_path);
     if (map.size() != truth.size()) throw common::InputError(truth_path, "differs in size from " + map_path);
-    each.input.free = map > 250;  // the survey's free pixels: white
-    each.input.resolution = kSurveyResolution;
+    each.map.resolution = kSurveyResolution;
+    each.map.cells = cv::Mat_<int8_t>(map.size(), common::OccupancyGrid::kOccupied);
+    each.map.cells.setTo(common::OccupancyGrid::kFree, map > 250);  // the survey's free pixels: white
     each.truth = segmentation::roomsFromBorderImage(truth);
     cases.push_back(each);
   }
@@ -77,9 +81,11 @@ std::vector<Case> environmentCases(const std::string& folder) {
     const world::RenderedEnvironment rendered = world::renderEnvironment(environment, {});
     Case each;
     each.name = fs::path(path).stem().string();
-    each.input.free = rendered.map.cells == common::OccupancyGrid::kFree;
-    each.input.resolution = rendered.map.resolution;
+    each.map = rendered.map;
     each.truth = rendered.space_labels;
+    for (const world::Space& space : environment.spaces)
+      each.truth_kinds.push_back(space.label == "CORRIDOR" ? segmentation::RoomKind::kCorridor
+                                                            : segmentation::RoomKind::kRoom);
     cases.push_back(each);
   }
   if (cases.empty()) throw common::InputError(folder, "holds no environment XML");
@@ -104,20 +110,12 @@ std::map<std::string, double> parseSettings(const std::vector<std::string>& sett
   return values;
 }
 
-cv::Mat3b picture(const cv::Mat1b& free, const cv::Mat1w& labels) {
-  cv::Mat3b image(free.size(), cv::Vec3b(0, 0, 0));
-  for (int row = 0; row < free.rows; ++row)
-    for (int col = 0; col < free.cols; ++col)
-      if (labels(row, col) != 0) image(row, col) = common::roomColour(labels(row, col));
-      else if (free(row, col) != 0) image(row, col) = cv::Vec3b(255, 255, 255);
-  return image;
-}
-
 int run(int argc, char** argv) {
   po::options_description options("Options");
   std::string survey_dir, environments_dir, methods_text = "default", params_path, only_text, out_dir;
   std::vector<std::string> settings;
   bool per_map = false;
+  segmentation::FloorSegmentationOptions floor_options;
   options.add_options()
       ("survey-maps", po::value(&survey_dir), "folder of NAME.png + NAME_gt_segmentation.png (the survey's maps)")
       ("environments", po::value(&environments_dir), "folder of environment XMLs (searched recursively)")
@@ -126,7 +124,7 @@ int run(int argc, char** argv) {
       ("set", po::value(&settings)->composing(), "NAME=VALUE: one parameter override (repeatable, after --params)")
       ("only", po::value(&only_text), "comma-separated map names to score (default: all)")
       ("per-map", po::bool_switch(&per_map), "print every map's scores, not only the means")
-      ("out", po::value(&out_dir), "folder for each map's labels (METHOD/NAME.png) and pictures (NAME_colour.png)");
+      ("out", po::value(&out_dir), "folder for each map's labels (METHOD/NAME.png) and pictures (NAME_preview.png)");
   po::variables_map values;
   if (!common::parseCommandLine(
           argc, argv,
@@ -135,7 +133,8 @@ int run(int argc, char** argv) {
           "                              [--out DIR]\n"
           "Scores room segmentation methods against ground truth: the survey's per-room recall and precision\n"
           "(micro: mean over rooms, macro: pooled over cells), Matthews' correlation coefficient over pairs of\n"
-          "cells, and the seconds per map.",
+          "cells, the seconds per map (segmentation and room graph), and on environments the share of rooms\n"
+          "given the right kind (corridor or room; a corridor: a space labelled CORRIDOR) and of corridors found.",
           options, {}, &values))
     return common::kExitOk;
   if (survey_dir.empty() && environments_dir.empty())
@@ -168,27 +167,43 @@ int run(int argc, char** argv) {
 
   std::cout << std::fixed << std::setprecision(3);
   std::cout << std::left << std::setw(16) << "method" << std::setw(24) << "map" << std::right
-            << "  rec_mi  pre_mi  rec_ma  pre_ma     mcc  rooms  found  seconds\n";
+            << "  rec_mi  pre_mi  rec_ma  pre_ma     mcc  rooms  found  seconds    kind corridor\n";
+  const auto printRow = [&](const std::string& method, const std::string& map,
+                            const segmentation::SegmentationScores& scores, double seconds,
+                            const segmentation::KindScores& kinds) {
+    std::cout << std::left << std::setw(16) << method << std::setw(24) << map << std::right << std::setw(8)
+              << scores.recall_micro << std::setw(8) << scores.precision_micro << std::setw(8) << scores.recall_macro
+              << std::setw(8) << scores.precision_macro << std::setw(8) << scores.mcc << std::setw(7)
+              << scores.truth_rooms << std::setw(7) << scores.found_rooms << std::setw(9) << seconds;
+    if (kinds.rooms > 0)
+      std::cout << std::setw(8) << kinds.accuracy() << std::setw(9)
+                << (kinds.corridors > 0 ? static_cast<double>(kinds.corridors_found) / kinds.corridors : 1.0);
+    std::cout << "\n";
+  };
   for (const auto& method : methods) {
+    floor_options.method = method->name();
+    floor_options.parameters = overrides;
     segmentation::SegmentationScores sum;
+    segmentation::KindScores kinds_sum;
     std::vector<double> seconds;
     for (const Case& each : cases) {
       const auto start = std::chrono::steady_clock::now();
-      const cv::Mat1w labels = segmentation::segmentRooms(*method, each.input, overrides);
+      const segmentation::SegmentedFloor floor = segmentation::segmentFloor(each.map, {}, {}, floor_options);
       seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
-      const segmentation::SegmentationScores scores = segmentation::scoreSegmentation(labels, each.truth);
+      const segmentation::SegmentationScores scores = segmentation::scoreSegmentation(floor.labels, each.truth);
+      segmentation::KindScores kinds;
+      if (!each.truth_kinds.empty()) {
+        std::vector<segmentation::RoomKind> found_kinds;
+        for (const segmentation::Room& room : floor.rooms) found_kinds.push_back(room.kind);
+        kinds = segmentation::scoreRoomKinds(floor.labels, found_kinds, each.truth, each.truth_kinds);
+      }
       if (!out_dir.empty()) {
         const std::string folder = out_dir + "/" + method->name();
         common::createOutputDirectory(folder);
-        common::saveLabelImage(labels, folder + "/" + each.name + ".png");
-        common::writeImage(folder + "/" + each.name + "_colour.png", picture(each.input.free, labels));
+        common::saveLabelImage(floor.labels, folder + "/" + each.name + ".png");
+        common::writeImage(folder + "/" + each.name + "_preview.png", segmentation::floorPreview(floor, each.map));
       }
-      if (per_map)
-        std::cout << std::left << std::setw(16) << method->name() << std::setw(24) << each.name << std::right
-                  << std::setw(8) << scores.recall_micro << std::setw(8) << scores.precision_micro << std::setw(8)
-                  << scores.recall_macro << std::setw(8) << scores.precision_macro << std::setw(8) << scores.mcc
-                  << std::setw(7) << scores.truth_rooms << std::setw(7) << scores.found_rooms << std::setw(9)
-                  << seconds.back() << "\n";
+      if (per_map) printRow(method->name(), each.name, scores, seconds.back(), kinds);
       sum.recall_micro += scores.recall_micro;
       sum.precision_micro += scores.precision_micro;
       sum.recall_macro += scores.recall_macro;
@@ -196,16 +211,21 @@ int run(int argc, char** argv) {
       sum.mcc += scores.mcc;
       sum.truth_rooms += scores.truth_rooms;
       sum.found_rooms += scores.found_rooms;
+      kinds_sum.rooms += kinds.rooms;
+      kinds_sum.correct += kinds.correct;
+      kinds_sum.corridors += kinds.corridors;
+      kinds_sum.corridors_found += kinds.corridors_found;
     }
     const double n = static_cast<double>(cases.size());
+    sum.recall_micro /= n;
+    sum.precision_micro /= n;
+    sum.recall_macro /= n;
+    sum.precision_macro /= n;
+    sum.mcc /= n;
     std::sort(seconds.begin(), seconds.end());
     const double median = seconds.size() % 2 ? seconds[seconds.size() / 2]
                                              : 0.5 * (seconds[seconds.size() / 2 - 1] + seconds[seconds.size() / 2]);
-    std::cout << std::left << std::setw(16) << method->name() << std::setw(24)
-              << ("mean of " + std::to_string(cases.size())) << std::right << std::setw(8) << sum.recall_micro / n
-              << std::setw(8) << sum.precision_micro / n << std::setw(8) << sum.recall_macro / n << std::setw(8)
-              << sum.precision_macro / n << std::setw(8) << sum.mcc / n << std::setw(7) << sum.truth_rooms
-              << std::setw(7) << sum.found_rooms << std::setw(9) << median << "  (median s)\n";
+    printRow(method->name(), "mean of " + std::to_string(cases.size()), sum, median, kinds_sum);
     std::cout << std::flush;
   }
   return common::kExitOk;

@@ -30,8 +30,7 @@ int run(int argc, char** argv) {
       ("out", po::value(&out_dir)->required(), "output folder (created)")
       ("method", po::value(&floor_options.method)->default_value(floor_options.method), "segmentation method")
       ("params", po::value(&params_path), "parameter overrides: flat YAML of name: number")
-      ("corridor-elongation", po::value(&floor_options.corridor_elongation)->default_value(4.0),
-       "a room at least this many times as long as wide is a corridor");
+;
   po::positional_options_description positional;
   positional.add("map", 1);
   std::string methods;
@@ -46,8 +45,6 @@ int run(int argc, char** argv) {
           "between them), DIR/rooms.xml (the thesis's environment schema) and DIR/preview.png.",
           options, positional, &values))
     return common::kExitOk;
-  if (!(floor_options.corridor_elongation > 0.0))
-    throw common::InputError("--corridor-elongation", "must be positive");
 
   // Read and check everything before writing anything.
   const common::OccupancyGrid map = common::loadMap(map_path);

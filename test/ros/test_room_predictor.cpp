@@ -7,6 +7,7 @@
 #include <geometry_msgs/PointStamped.h>
 #include <hidden_rooms/PredictRooms.h>
 #include <hidden_rooms/SaveDoors.h>
+#include <hidden_rooms/SegmentRooms.h>
 #include <nav_msgs/OccupancyGrid.h>
 #include <ros/ros.h>
 #include <visualization_msgs/MarkerArray.h>
@@ -270,6 +271,73 @@ TEST(RoomPredictor, PublishesLatchedOverlays) {
   EXPECT_EQ(per_namespace["doors"], 1);
   EXPECT_EQ(per_namespace["debug_extended_lines"], 1);  // ~publish_debug is on in the launch file
   EXPECT_EQ(per_namespace["debug_in_out_cells"], 1);
+}
+
+// segment_rooms with the predicted rooms: the rooms of segment_rooms (the tool) on the map, doors and prediction,
+// its markers latched on room_segmentation; bad requests fail with a message.
+TEST(RoomPredictor, SegmentsTheMapWithThePredictedRooms) {
+  REQUIRE_CASE();
+  const hidden_rooms::common::DoorsFile doors = hidden_rooms::common::loadDoors(caseDir() + "/doors.yaml");
+  PredictRooms prediction_call;  // the latest prediction: the doors file's, by default
+  prediction_call.request.doors = hidden_rooms::toRos(doors);
+  prediction_call.request.method = "default";
+  ASSERT_TRUE(call(&prediction_call));
+  ASSERT_TRUE(prediction_call.response.success) << prediction_call.response.message;
+  hidden_rooms::SegmentRooms service;
+  service.request.with_predicted_rooms = true;
+  ASSERT_TRUE(ros::service::waitForService("segment_rooms", ros::Duration(30.0)));
+  ASSERT_TRUE(ros::service::call("segment_rooms", service));
+  ASSERT_TRUE(service.response.success) << service.response.message;
+  int predicted = 0, corridors = 0;
+  for (const hidden_rooms::SegmentedRoom& room : service.response.rooms) {
+    predicted += room.predicted;
+    corridors += room.kind == hidden_rooms::SegmentedRoom::CORRIDOR;
+    EXPECT_GE(room.outline.size(), 3u);
+  }
+  EXPECT_GE(predicted, static_cast<int>(doors.doors.size()) - 2);  // a door or two may be not placed
+  EXPECT_GE(corridors, 1);
+  int door_passages = 0;
+  for (const hidden_rooms::RoomPassage& passage : service.response.passages) {
+    EXPECT_GE(passage.room_a, 1u);
+    EXPECT_LE(passage.room_a, service.response.rooms.size());
+    door_passages += passage.kind != hidden_rooms::RoomPassage::OPEN;
+  }
+  EXPECT_EQ(door_passages, static_cast<int>(doors.doors.size()));
+  const hidden_rooms::common::OccupancyGrid map = hidden_rooms::common::loadMap(caseDir() + "/map.yaml");
+  EXPECT_EQ(service.response.labels.width, static_cast<uint32_t>(map.width()));
+  EXPECT_EQ(service.response.labels.height, static_cast<uint32_t>(map.height()));
+  EXPECT_EQ(service.response.labels.encoding, "mono16");
+
+  // The same as the offline tool on the offline prediction (labels flipped back to the file's row order).
+  const std::string prediction = runOffline("default");
+  const std::string out = testing_util::makeTempDir("room_predictor_segment");
+  const testing_util::CommandResult result = testing_util::runCommand(
+      std::string(SEGMENT_ROOMS_BIN) + " " + caseDir() + "/map.yaml --doors " + caseDir() + "/doors.yaml --rooms " +
+      prediction + "/rooms.yaml --out " + out);
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const YAML::Node offline = YAML::LoadFile(out + "/rooms.yaml");
+  EXPECT_EQ(offline["rooms"].size(), service.response.rooms.size());
+  EXPECT_EQ(offline["passages"].size(), service.response.passages.size());
+
+  ros::NodeHandle nh;
+  const auto markers =
+      ros::topic::waitForMessage<visualization_msgs::MarkerArray>("room_segmentation", nh, ros::Duration(30.0));
+  ASSERT_TRUE(markers != nullptr);
+  std::map<std::string, int> per_namespace;
+  for (const visualization_msgs::Marker& marker : markers->markers) ++per_namespace[marker.ns];
+  EXPECT_EQ(per_namespace["room_labels"], static_cast<int>(service.response.rooms.size()));
+  EXPECT_GE(per_namespace["room_graph"], 2);
+
+  hidden_rooms::SegmentRooms bad;
+  bad.request.method = "nope";
+  ASSERT_TRUE(ros::service::call("segment_rooms", bad));
+  EXPECT_FALSE(bad.response.success);
+  EXPECT_NE(bad.response.message.find("unknown segmentation method 'nope'"), std::string::npos);
+  hidden_rooms::SegmentRooms no_map;
+  ASSERT_TRUE(ros::service::waitForService("no_map/segment_rooms", ros::Duration(30.0)));
+  ASSERT_TRUE(ros::service::call("no_map/segment_rooms", no_map));
+  EXPECT_FALSE(no_map.response.success);
+  EXPECT_NE(no_map.response.message.find("none was received"), std::string::npos) << no_map.response.message;
 }
 
 TEST(RoomPredictor, WritesTheCompletedMapAsAnOctomap) {

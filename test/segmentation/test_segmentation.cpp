@@ -2,6 +2,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "hidden_rooms/common/file_io.h"
 #include "hidden_rooms/common/image_io.h"
 #include "hidden_rooms/common/input_error.h"
 #include "hidden_rooms/segmentation/floor_output.h"
@@ -66,15 +67,19 @@ TEST(Segmentation, EveryMethodFindsTheRoomsOffACorridor) {
   for (const std::string& method : roomSegmenterNames()) {
     SCOPED_TRACE(method);
     const cv::Mat1w labels = segmentRooms(*makeRoomSegmenter(method), floor.input());
-    double rooms = 0.0;
-    cv::minMaxLoc(labels, nullptr, &rooms);
-    EXPECT_EQ(rooms, 5.0);
     const SegmentationScores scores = scoreSegmentation(labels, floor.truth);
-    EXPECT_GT(scores.recall_micro, 0.97);
-    EXPECT_GT(scores.precision_micro, 0.97);
-    EXPECT_GT(scores.mcc, 0.95);
+    EXPECT_GT(scores.precision_micro, 0.97);  // no segment spans two rooms
     // Every free cell has a room and no wall cell has one.
     EXPECT_EQ(cv::countNonZero((labels > 0) != floor.input().free), 0);
+    if (method == "voronoi") {
+      // The survey's Voronoi method cuts a long corridor into pieces (its merge rules keep a 2 m wide corridor
+      // longer than about 16 m split); the rooms are still found whole.
+      EXPECT_GT(scores.recall_micro, 0.9);
+      continue;
+    }
+    EXPECT_EQ(scores.found_rooms, 5);
+    EXPECT_GT(scores.recall_micro, 0.97);
+    EXPECT_GT(scores.mcc, 0.95);
   }
 }
 
@@ -104,6 +109,18 @@ TEST(Segmentation, ARoomWithAWideOpenEndIsNotCutFromItsCorridor) {
   floor.room(1, 1.0, 1.0, 10.0, 3.5);
   floor.room(1, 10.0, 1.0, 19.0, 4.0);
   EXPECT_EQ(scoresOf("default", floor).found_rooms, 1);
+}
+
+TEST(RoomSegmentation, ShippedParameterFileEqualsTheDefaults) {
+  const auto file = common::loadParameterFile(std::string(HIDDEN_ROOMS_SOURCE_DIR) + "/config/segmentation.yaml");
+  std::map<std::string, double> defaults;
+  for (const std::string& name : roomSegmenterNames())
+    for (const auto& [key, value] : makeRoomSegmenter(name)->defaultParameters()) defaults[key] = value;
+  EXPECT_EQ(file.size(), defaults.size());
+  for (const auto& [key, value] : file) {
+    ASSERT_TRUE(defaults.count(key)) << key << " is in config/segmentation.yaml but no method reads it";
+    EXPECT_DOUBLE_EQ(value, defaults[key]) << key;
+  }
 }
 
 TEST(SegmentationMetrics, HandMadeLabelImagesGiveTheSurveysScores) {
@@ -257,7 +274,7 @@ TEST(RoomSegmentation, AccuracyOnTheSurveysMaps) {
   const std::vector<std::string> names = {"Freiburg79_scan", "NLB",      "lab_a_scan", "lab_c_scan", "lab_intel",
                                           "lab_ipa",         "office_a", "office_c",   "office_e",   "office_g"};
   const std::map<std::string, std::pair<double, double>> floors = {
-      {"default", {0.97, 0.94}}, {"morphological", {0.97, 0.89}}};
+      {"default", {0.97, 0.94}}, {"morphological", {0.97, 0.89}}, {"voronoi", {0.95, 0.94}}};
   for (const auto& [method, floor] : floors) {
     double recall = 0.0, precision = 0.0;
     for (const std::string& name : names) {

@@ -9,12 +9,15 @@
 #include <hidden_rooms/ClosedDoor.h>
 #include <hidden_rooms/PredictedRoom.h>
 #include <hidden_rooms/PredictionParameter.h>
+#include <hidden_rooms/RoomPassage.h>
+#include <hidden_rooms/SegmentedRoom.h>
 #include <geometry_msgs/PoseArray.h>
 #include <geometry_msgs/TransformStamped.h>
 #include <geometry_msgs/Twist.h>
 #include <nav_msgs/Odometry.h>
 #include <nav_msgs/OccupancyGrid.h>
 #include <ros/time.h>
+#include <sensor_msgs/Image.h>
 #include <sensor_msgs/LaserScan.h>
 
 #include "hidden_rooms/common/doors_file.h"
@@ -22,6 +25,7 @@
 #include "hidden_rooms/common/range_scan.h"
 #include "hidden_rooms/mapping/rbpf_mapper.h"
 #include "hidden_rooms/prediction/room_predictor.h"
+#include "hidden_rooms/segmentation/room_graph.h"
 #include "hidden_rooms/simulation/simulation.h"
 
 namespace hidden_rooms {
@@ -54,6 +58,12 @@ hidden_rooms::PredictedRoom toRos(const prediction::RoomPrediction& room, int la
 // The room back with its mask at the map's size (255 on its cells). Throws InputError when the mask does not lie
 // on the map's cell grid or term names and values differ in length.
 prediction::RoomPrediction fromRos(const hidden_rooms::PredictedRoom& message, const common::OccupancyGrid& map);
+
+// A segmented floor's rooms and passages, and its labels as a mono16 image with the rows in the order of the map
+// message (row 0 at the map's origin, unlike the label image files, whose row 0 is the map's top row).
+hidden_rooms::SegmentedRoom toRos(const segmentation::Room& room);
+hidden_rooms::RoomPassage toRos(const segmentation::Passage& passage);
+sensor_msgs::Image labelsToRos(const cv::Mat1w& labels, const std::string& frame_id, const ros::Time& stamp);
 
 // Simulator. A velocity command as it came (non-finite values pass: Simulation::setCommand rejects them).
 common::VelocityCommand fromRos(const geometry_msgs::Twist& message);

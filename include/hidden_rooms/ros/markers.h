@@ -17,6 +17,7 @@
 #include "hidden_rooms/exploration/frontier.h"
 #include "hidden_rooms/prediction/layout.h"
 #include "hidden_rooms/prediction/room_predictor.h"
+#include "hidden_rooms/segmentation/room_graph.h"
 
 namespace hidden_rooms {
 
@@ -31,6 +32,13 @@ visualization_msgs::MarkerArray toMarkers(const common::OccupancyGrid& map, cons
 // orange, boundary lines grey) and its cells ("debug_in_out_cells": IN cells green, OUT cells red, translucent).
 visualization_msgs::MarkerArray toDebugMarkers(const common::OccupancyGrid& map, const prediction::Layout& layout,
                                                const std::string& frame_id, const ros::Time& stamp);
+
+// A segmented floor in `frame_id`: per room its outline ("room_outlines", room colour; predicted rooms paler), a
+// text with its number, type and area ("room_labels"), a sphere at its centroid ("room_nodes"); the topological map's
+// edges from each room's centroid to the passage ("room_graph": open doorways green, closed doors red, doors to
+// predicted rooms orange).
+visualization_msgs::MarkerArray toMarkers(const segmentation::SegmentedFloor& floor, const std::string& frame_id,
+                                          const ros::Time& stamp);
 
 // What the explorer shows of one plan (map frame).
 struct ExplorationView {

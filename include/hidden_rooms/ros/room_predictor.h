@@ -12,6 +12,7 @@
 #include <hidden_rooms/PredictRooms.h>
 #include <hidden_rooms/RoomPredictorConfig.h>
 #include <hidden_rooms/SaveDoors.h>
+#include <hidden_rooms/SegmentRooms.h>
 #include <nav_msgs/OccupancyGrid.h>
 #include <ros/ros.h>
 #include <tf2_ros/static_transform_broadcaster.h>
@@ -21,6 +22,7 @@
 #include "hidden_rooms/common/occupancy_grid.h"
 #include "hidden_rooms/common/options.h"
 #include "hidden_rooms/prediction/room_predictor.h"
+#include "hidden_rooms/segmentation/room_graph.h"
 
 namespace hidden_rooms {
 
@@ -46,6 +48,10 @@ struct RoomPredictorOptions {
   // A tf frame at the centre of the latest map's known cells (static, child of the map's frame): the shipped rviz
   // views look at it, so they centre on any map; "" = none.
   std::string view_frame = "map_view";
+  // Room segmentation (segment_rooms service, room_segmentation markers).
+  std::string segmentation_method = "default";  // method of segment_rooms requests that name none
+  std::string segmentation_params_file;  // flat `name: number` overrides of the segmentation; "" = none
+  bool segment_on_prediction = true;     // after each prediction, segment its map with the predicted rooms
   // Requests beyond these are refused (bounded answer times and memory).
   int max_doors = common::kMaxDoors;
   int max_map_cells = static_cast<int>(common::kMaxMapCells);  // 5000 x 5000 cells: 250 m x 250 m at 0.05 m
@@ -59,7 +65,9 @@ std::vector<common::OptionDescription> roomPredictorParameters();
 RoomPredictorOptions readRoomPredictorOptions(const ros::NodeHandle& private_nh);
 
 // Serves `predict_rooms` (PredictRooms) over the latest map of `map` or the request's own map, and publishes
-// each prediction, latched, as `predicted_map` (the completed map) and `predicted_rooms` (rviz markers). The
+// each prediction, latched, as `predicted_map` (the completed map) and `predicted_rooms` (rviz markers). Serves
+// `segment_rooms` (SegmentRooms) and publishes each segmentation, latched, as `room_segmentation` (rviz markers);
+// with ~segment_on_prediction every prediction is followed by a segmentation with its predicted rooms. The
 // method and the parameters of requests that name none can be changed live (dynamic_reconfigure,
 // cfg/RoomPredictor.cfg): the node then predicts its own doors again.
 class RoomPredictorNode {
@@ -70,6 +78,8 @@ class RoomPredictorNode {
 
   // The service: never throws; every failure is success = false with a message.
   bool predictRooms(PredictRooms::Request& request, PredictRooms::Response& response);
+  // The segmentation service: never throws; every failure is success = false with a message.
+  bool segmentRooms(SegmentRooms::Request& request, SegmentRooms::Response& response);
   // save_doors: writes the node's doors; never throws.
   bool saveDoors(SaveDoors::Request& request, SaveDoors::Response& response);
 
@@ -83,6 +93,16 @@ class RoomPredictorNode {
   void predictAndLog(const std::string& why);
   // Predicts and publishes; throws InputError for an unusable request.
   void predict(const PredictRooms::Request& request, PredictRooms::Response* response);
+  // The request's map, or the latest one (checked against ~max_map_cells), as map_saver would save it; throws
+  // InputError when there is none or it is too large. `frame`: its frame.
+  common::OccupancyGrid requestMap(const nav_msgs::OccupancyGrid& request_map, std::string* frame) const;
+  // The request's doors, else the node's; throws InputError when neither has any and `required`.
+  common::DoorsFile requestDoors(const std::vector<ClosedDoor>& request_doors, const std::string& frame,
+                                 bool required) const;
+  // Segments and publishes room_segmentation; throws InputError for an unusable request.
+  segmentation::SegmentedFloor segment(const common::OccupancyGrid& map, const common::DoorsFile& doors,
+                                       const cv::Mat1w& predicted_rooms, const std::string& method,
+                                       const std::string& frame);
   // dynamic_reconfigure: takes the method and the parameters (those ~params_file sets, and those that differ from
   // the .cfg's defaults, i.e. config/*.yaml's) and predicts the node's doors again. A method or value that the
   // prediction refuses puts `config` back to the settings before, with a warning naming it.
@@ -103,6 +123,13 @@ class RoomPredictorNode {
   ros::Subscriber map_subscriber_;
   ros::Publisher predicted_map_publisher_;
   ros::Publisher markers_publisher_;
+  ros::Publisher segmentation_publisher_;
+  ros::ServiceServer segmentation_service_;
+  std::map<std::string, double> segmentation_parameters_;  // ~segmentation_params_file's
+  // The latest prediction's rooms (labels in its map's grid) and that map's geometry, for with_predicted_rooms.
+  cv::Mat1w latest_prediction_labels_;
+  common::Point2 latest_prediction_origin_ = common::Point2::Zero();
+  double latest_prediction_resolution_ = 0.0;
   ros::ServiceServer service_;
   ros::ServiceServer save_doors_service_;
   ros::Subscriber click_subscriber_;

@@ -2,7 +2,8 @@
 
 // The files a segmented floor is saved as (segment_rooms):
 //   DIR/rooms.png    label image of the map's size: 0 outside every room, k on the cells of room k
-//   DIR/rooms.yaml   the rooms (label, kind, predicted, area, width, centroid, outline) and the passages between them
+//   DIR/rooms.yaml   the rooms (label, kind, type, predicted, area, width, centroid, outline) and the passages between
+//                    them
 //   DIR/rooms.xml    the floor in the thesis's environment schema (spaces with outlines, labels and portals)
 //   DIR/preview.png  picture: rooms tinted, passages as lines between room centroids (open green, closed red,
 //                    predicted orange)
@@ -19,7 +20,8 @@
 namespace hidden_rooms::segmentation {
 
 // The floor as an environment of the thesis's schema, frame = the grid's (its lower-left corner at 0, 0), one pixel
-// per cell: a space per room (type C / R, label CORRIDOR / ROOM / PREDICTED ROOM) whose walls are its outline's
+// per cell: a space per room (type C for corridors, else R; label its type in capitals, e.g. CORRIDOR, OFFICE,
+// PREDICTED CLASSROOM; ROOM when it has none) whose walls are its outline's
 // edges, and a PORTAL per passage on the outline of its first room (closed and predicted doors with status
 // CLOSED). Reads back with world::loadEnvironment.
 world::Environment floorToEnvironment(const SegmentedFloor& floor, const common::OccupancyGrid& map,

@@ -26,7 +26,8 @@ struct Room {
   common::Point2 centroid = common::Point2::Zero();  // map frame, metres
   common::Polygon outline;        // outer border of its cells, map frame, metres, counter-clockwise
   double width = 0.0;             // metres: twice the largest distance from a cell to the room's border
-  RoomKind kind = RoomKind::kRoom;
+  RoomKind kind = RoomKind::kRoom;  // corridor: its type is corridor
+  std::string type;               // one of roomTypeNames() (room_types.h); "" when not classified
   bool predicted = false;         // a predicted room behind a closed door (not explored)
 };
 
@@ -53,8 +54,9 @@ struct SegmentedFloor {
 struct FloorSegmentationOptions {
   std::string method = "default";
   std::map<std::string, double> parameters;  // overrides of the method's defaults
-  // A room is a corridor when it is at least this many times as long as it is wide (area / width² >= ratio).
-  double corridor_elongation = 4.0;
+  // Give every room a type and its kind with the shipped room type model (room_types.h); false: every room is of
+  // kind room, without a type (for training that model).
+  bool classify_rooms = true;
 };
 
 // Segments the free cells of `map` (cells <= 19 after map_saver's rule) with the closed doors of `doors` drawn as

@@ -3,7 +3,13 @@
 // Scores of a room segmentation against ground truth: the survey's per-room recall and precision (Bormann et al.,
 // ICRA 2016, as ipa_room_segmentation computes them) and Matthews' correlation coefficient over pairs of cells.
 
+#include <map>
+#include <string>
+#include <vector>
+
 #include <opencv2/core.hpp>
+
+#include "hidden_rooms/segmentation/room_graph.h"
 
 namespace hidden_rooms::segmentation {
 
@@ -31,8 +37,22 @@ struct SegmentationScores {
 SegmentationScores scoreSegmentation(const cv::Mat1w& found, const cv::Mat1w& truth,
                                      int min_region_cells = kSurveyMinRegionCells);
 
+// How well the rooms' kinds (and types) match the ground truth's: each found room (of at least `min_region_cells`
+// cells) takes the kind of the ground-truth room that overlaps it most; rooms overlapping none are not scored.
+struct KindScores {
+  int rooms = 0;           // found rooms scored
+  int correct = 0;         // with the ground truth's kind
+  int corridors = 0;       // found rooms whose ground truth is a corridor
+  int corridors_found = 0; // ... and that are called corridors
+  double accuracy() const { return rooms > 0 ? static_cast<double>(correct) / rooms : 0.0; }
+};
+// `found_kinds[k - 1]`: the kind of found room k; `truth_kinds[k - 1]`: of ground-truth room k. Throws InputError
+// when the images differ in size or a label has no kind.
+KindScores scoreRoomKinds(const cv::Mat1w& found, const std::vector<RoomKind>& found_kinds, const cv::Mat1w& truth,
+                          const std::vector<RoomKind>& truth_kinds, int min_region_cells = kSurveyMinRegionCells);
+
 // The ground truth of the survey's test maps: an 8-bit image with the room borders drawn in black; each
-// 8-connected region of pixels above 250 is a room (label 1..N, row-major order of first cell), the rest 0.
+// 8-connected region of pixels above 250 is a room (labels 1..N), the rest 0.
 cv::Mat1w roomsFromBorderImage(const cv::Mat1b& image);
 
 }  // namespace hidden_rooms::segmentation

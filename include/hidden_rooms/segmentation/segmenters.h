@@ -32,4 +32,16 @@ class MorphologicalSegmenter : public RoomSegmenter {
   cv::Mat1i segment(const SegmentationInput& input, const std::map<std::string, double>& parameters) const override;
 };
 
+// "voronoi" (the survey's): critical points on the generalized Voronoi graph of the free space (after pruning its
+// side branches, the point nearest to a wall in each neighbourhood along the graph, neighbourhoods the longer the
+// narrower the passage); from each a critical line to the two nearest wall cells on either side, the one with the
+// widest angle kept among close points; the regions the lines separate grow into the free space and merge by the
+// survey's rules (small parts, parts closed off by walls, parts sharing much of their perimeter).
+class VoronoiSegmenter : public RoomSegmenter {
+ public:
+  std::string name() const override { return "voronoi"; }
+  std::map<std::string, double> defaultParameters() const override;
+  cv::Mat1i segment(const SegmentationInput& input, const std::map<std::string, double>& parameters) const override;
+};
+
 }  // namespace hidden_rooms::segmentation

@@ -1,0 +1,218 @@
+#include "hidden_rooms/segmentation/room_types.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <set>
+
+#include <opencv2/imgproc.hpp>
+#include <opencv2/ml.hpp>
+
+#include "hidden_rooms/common/input_error.h"
+
+// The shipped model, built into the library: CMake sets HIDDEN_ROOMS_ROOM_TYPES_MODEL to its path (and rebuilds
+// this file when it changes), so that no file has to be found at run time.
+asm(".pushsection .rodata\n"
+    "hidden_rooms_room_types_model:\n"
+    ".incbin \"" HIDDEN_ROOMS_ROOM_TYPES_MODEL "\"\n"
+    "hidden_rooms_room_types_model_end:\n"
+    ".byte 0\n"
+    ".popsection\n");
+extern "C" const char hidden_rooms_room_types_model[];
+extern "C" const char hidden_rooms_room_types_model_end[];
+
+namespace hidden_rooms::segmentation {
+
+namespace {
+
+// Per room: the mean of the distance to its border over its cells, divided by the largest (1: a uniform width).
+std::vector<double> widthUniformity(const SegmentedFloor& floor) {
+  std::vector<double> uniformity(floor.rooms.size(), 0.0);
+  std::vector<cv::Rect> boxes(floor.rooms.size());
+  for (int row = 0; row < floor.labels.rows; ++row)
+    for (int col = 0; col < floor.labels.cols; ++col) {
+      const int label = floor.labels(row, col);
+      if (label == 0) continue;
+      const cv::Rect cell(col, row, 1, 1);
+      boxes[label - 1] = boxes[label - 1].empty() ? cell : (boxes[label - 1] | cell);
+    }
+  for (size_t i = 0; i < floor.rooms.size(); ++i) {
+    const cv::Rect& box = boxes[i];
+    if (box.empty()) continue;
+    cv::Mat1b local(box.height + 2, box.width + 2, uchar(0));
+    cv::Mat1b(floor.labels(box) == static_cast<int>(i) + 1).copyTo(local(cv::Rect(1, 1, box.width, box.height)));
+    cv::Mat1f distance;
+    cv::distanceTransform(local, distance, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+    double max_distance = 0.0;
+    cv::minMaxLoc(distance, nullptr, &max_distance);
+    if (max_distance > 0.0) uniformity[i] = cv::mean(distance, local)[0] / max_distance;
+  }
+  return uniformity;
+}
+
+double outlineLength(const common::Polygon& outline) {
+  double length = 0.0;
+  for (size_t i = 0; i < outline.size(); ++i) length += (outline[(i + 1) % outline.size()] - outline[i]).norm();
+  return length;
+}
+
+}  // namespace
+
+const std::vector<std::string>& roomTypeNames() {
+  static const std::vector<std::string> names = {"corridor", "office", "classroom", "washroom",
+                                                 "storage",  "hall",   "stairs"};
+  return names;
+}
+
+std::string roomTypeOfLabel(const std::string& label) {
+  static const std::map<std::string, std::string> types = {
+      {"CORRIDOR", "corridor"},
+      {"OFFICE", "office"},          {"SHARED OFFICE", "office"},      {"EXECUTIVE OFFICE", "office"},
+      {"SMALL ADMINISTRATIVE", "office"}, {"MEDIUM ADMINISTRATIVE", "office"}, {"BIG ADMINISTRATIVE", "office"},
+      {"CUBICULE", "office"},        {"RECEPTION", "office"},
+      {"CLASSROOM", "classroom"},    {"LAB", "classroom"},             {"LIBRARY", "classroom"},
+      {"CONFERENCE", "classroom"},   {"CONFERENCE ROOM", "classroom"}, {"CONFERENCE HALL", "classroom"},
+      {"WASHROOM", "washroom"},      {"BATHROOM", "washroom"},
+      {"CLOSET", "storage"},         {"SMALL", "storage"},             {"MEDIUM", "storage"},
+      {"MEDIUM SERVICE", "storage"}, {"BIG SERVICE", "storage"},       {"COLLECTIVE SERVICE ROOM", "storage"},
+      {"KITCHEN", "storage"},
+      {"HALL", "hall"},              {"LOBBY", "hall"},                {"ENTRANCE", "hall"},
+      {"OPENSPACE", "hall"},         {"CANTEEN", "hall"},              {"CAFETERIA", "hall"},
+      {"GYM", "hall"},               {"CONVENIENCE STORE", "hall"},
+      {"STAIRS", "stairs"},          {"ELEVATOR", "stairs"},
+  };
+  const auto found = types.find(label);
+  return found == types.end() ? "" : found->second;
+}
+
+const std::vector<std::string>& roomFeatureNames() {
+  static const std::vector<std::string> names = {
+      "area",        "width",       "elongation",  "width_uniformity", "long_side",       "short_side",
+      "aspect",      "rectangularity", "compactness", "passages",      "neighbours",      "relative_area",
+      "area_rank",   "largest_neighbour_ratio", "dead_end_neighbours", "passage_share"};
+  return names;
+}
+
+cv::Mat1f roomFeatures(const SegmentedFloor& floor) {
+  const size_t count = floor.rooms.size();
+  cv::Mat1f features(static_cast<int>(count), static_cast<int>(roomFeatureNames().size()), 0.0f);
+  if (count == 0) return features;
+  const std::vector<double> uniformity = widthUniformity(floor);
+  std::vector<int> passages(count, 0);
+  std::vector<double> passage_width(count, 0.0);
+  std::vector<std::set<int>> neighbours(count);
+  for (const Passage& passage : floor.passages) {
+    for (const int label : {passage.room_a, passage.room_b})
+      if (label != 0) {
+        ++passages[label - 1];
+        passage_width[label - 1] += passage.width;
+      }
+    if (passage.room_a != 0 && passage.room_b != 0) {
+      neighbours[passage.room_a - 1].insert(passage.room_b - 1);
+      neighbours[passage.room_b - 1].insert(passage.room_a - 1);
+    }
+  }
+  std::vector<double> areas;
+  for (const Room& room : floor.rooms) areas.push_back(room.area);
+  std::vector<double> sorted = areas;
+  std::sort(sorted.begin(), sorted.end());
+  const double median = sorted[sorted.size() / 2];
+  for (size_t i = 0; i < count; ++i) {
+    const Room& room = floor.rooms[i];
+    std::vector<cv::Point2f> outline;
+    for (const common::Point2& vertex : room.outline) outline.emplace_back(vertex.x(), vertex.y());
+    const cv::RotatedRect box = outline.size() >= 3 ? cv::minAreaRect(outline) : cv::RotatedRect();
+    const double long_side = std::max(box.size.width, box.size.height);
+    const double short_side = std::min(box.size.width, box.size.height);
+    double largest_neighbour = 0.0;
+    int dead_ends = 0;
+    for (const int other : neighbours[i]) {
+      largest_neighbour = std::max(largest_neighbour, areas[other]);
+      dead_ends += passages[other] == 1;
+    }
+    const double perimeter = outlineLength(room.outline);
+    const double rank = static_cast<double>(std::lower_bound(sorted.begin(), sorted.end(), room.area) - sorted.begin());
+    const std::vector<double> values = {
+        room.area,
+        room.width,
+        room.width > 0.0 ? room.area / (room.width * room.width) : 0.0,
+        uniformity[i],
+        long_side,
+        short_side,
+        short_side > 0.0 ? long_side / short_side : 0.0,
+        long_side * short_side > 0.0 ? room.area / (long_side * short_side) : 0.0,
+        room.area > 0.0 ? perimeter / std::sqrt(room.area) : 0.0,
+        static_cast<double>(passages[i]),
+        static_cast<double>(neighbours[i].size()),
+        median > 0.0 ? room.area / median : 0.0,
+        count > 1 ? rank / (count - 1) : 0.5,
+        room.area > 0.0 ? largest_neighbour / room.area : 0.0,
+        static_cast<double>(dead_ends),
+        perimeter > 0.0 ? passage_width[i] / perimeter : 0.0,
+    };
+    for (size_t j = 0; j < values.size(); ++j) features(static_cast<int>(i), static_cast<int>(j)) = static_cast<float>(values[j]);
+  }
+  return features;
+}
+
+RoomTypeClassifier::RoomTypeClassifier(cv::Ptr<cv::ml::RTrees> forest) : forest_(std::move(forest)) {}
+
+const RoomTypeClassifier& RoomTypeClassifier::shipped() {
+  static const RoomTypeClassifier classifier = fromText(
+      std::string(hidden_rooms_room_types_model, hidden_rooms_room_types_model_end), "models/room_types.yml");
+  return classifier;
+}
+
+RoomTypeClassifier RoomTypeClassifier::fromText(const std::string& model_text, const std::string& source_name) {
+  cv::Ptr<cv::ml::RTrees> forest;
+  try {
+    cv::FileStorage storage(model_text, cv::FileStorage::READ | cv::FileStorage::MEMORY);
+    forest = cv::ml::RTrees::create();
+    forest->read(storage.getFirstTopLevelNode());
+  } catch (const cv::Exception& error) {
+    throw common::InputError(source_name, std::string("is not a room type model: ") + error.what());
+  }
+  if (!forest->isTrained() || forest->getVarCount() != static_cast<int>(roomFeatureNames().size()))
+    throw common::InputError(source_name, "is not a room type model of " +
+                                              std::to_string(roomFeatureNames().size()) + " features");
+  return RoomTypeClassifier(forest);
+}
+
+RoomTypeClassifier RoomTypeClassifier::train(const cv::Mat1f& features, const std::vector<int>& types) {
+  cv::Ptr<cv::ml::RTrees> forest = cv::ml::RTrees::create();
+  forest->setMaxDepth(8);
+  forest->setMinSampleCount(5);
+  forest->setCalculateVarImportance(false);
+  forest->setTermCriteria(cv::TermCriteria(cv::TermCriteria::MAX_ITER, 50, 0.0));
+  forest->train(cv::ml::TrainData::create(features, cv::ml::ROW_SAMPLE, cv::Mat(types, true)));
+  return RoomTypeClassifier(forest);
+}
+
+std::vector<int> RoomTypeClassifier::classify(const cv::Mat1f& features) const {
+  std::vector<int> types;
+  if (features.empty()) return types;
+  cv::Mat predictions;
+  forest_->predict(features, predictions);
+  for (int row = 0; row < predictions.rows; ++row) types.push_back(static_cast<int>(std::lround(predictions.at<float>(row))));
+  return types;
+}
+
+std::string RoomTypeClassifier::toText() const {
+  cv::FileStorage storage(".yml", cv::FileStorage::WRITE | cv::FileStorage::MEMORY);
+  storage << "room_types";
+  storage << "{";
+  forest_->write(storage);
+  storage << "}";
+  return storage.releaseAndGetString();
+}
+
+void classifyRooms(const RoomTypeClassifier& classifier, SegmentedFloor* floor) {
+  const std::vector<int> types = classifier.classify(roomFeatures(*floor));
+  for (size_t i = 0; i < floor->rooms.size(); ++i) {
+    Room& room = floor->rooms[i];
+    room.type = roomTypeNames().at(static_cast<size_t>(types[i]));
+    room.kind = room.type == "corridor" ? RoomKind::kCorridor : RoomKind::kRoom;
+  }
+}
+
+}  // namespace hidden_rooms::segmentation
