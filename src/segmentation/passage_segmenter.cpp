@@ -4,6 +4,7 @@
 #include <vector>
 
 #include <opencv2/imgproc.hpp>
+#include <opencv2/ximgproc.hpp>
 
 #include "hidden_rooms/segmentation/segmenters.h"
 
@@ -38,6 +39,93 @@ class Basins {
   std::vector<float> peak_;
 };
 
+const cv::Point kNeighbours[] = {{-1, -1}, {0, -1}, {1, -1}, {-1, 0}, {1, 0}, {-1, 1}, {0, 1}, {1, 1}};
+
+bool inside(const cv::Mat& image, const cv::Point& cell) {
+  return cell.x >= 0 && cell.y >= 0 && cell.x < image.cols && cell.y < image.rows;
+}
+
+// The cells of the line from `from` along `direction` (unit), one per step of a cell, at most `steps`.
+std::vector<cv::Point> ray(const cv::Point2d& from, const cv::Point2d& direction, int steps) {
+  std::vector<cv::Point> cells;
+  for (int step = 1; step <= steps; ++step) {
+    const cv::Point2d at = from + direction * step;
+    cells.emplace_back(static_cast<int>(std::lround(at.x)), static_cast<int>(std::lround(at.y)));
+  }
+  return cells;
+}
+
+// Closes the openings of straight walls: from the free end (tip) of every thin wall, along the wall's direction,
+// the free run to the next obstacle becomes a border when it is at most `max_gap` cells long and the wall line goes
+// on beyond that obstacle (a thin wall along the same line, at least `min_run` cells, with no free run longer than
+// `max_gap` before it). So a room whose open front lies on a corridor's wall line is cut from the corridor along
+// that line, while a wall that ends in a corridor does not cut it (no wall continues its line across).
+cv::Mat1b closeWallGaps(const cv::Mat1b& free, int max_gap, int min_run, int max_wall_thickness) {
+  // Thin walls: obstacle cells that an opening by a disc wider than a wall removes (thick blocks and the
+  // unknown outside stay).
+  const cv::Mat1b obstacle = free == 0;
+  cv::Mat1b thick;
+  const int diameter = max_wall_thickness + 1;
+  cv::morphologyEx(obstacle, thick, cv::MORPH_OPEN,
+                   cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(diameter, diameter)));
+  const cv::Mat1b thin = obstacle & ~thick;
+  cv::Mat1b skeleton;
+  cv::ximgproc::thinning(thin, skeleton, cv::ximgproc::THINNING_GUOHALL);
+
+  cv::Mat1b closed = free.clone();
+  for (int row = 0; row < skeleton.rows; ++row)
+    for (int col = 0; col < skeleton.cols; ++col) {
+      if (skeleton(row, col) == 0) continue;
+      // A tip: one skeleton neighbour. Its direction: from the skeleton cell min_run steps back to the tip.
+      cv::Point tip(col, row), previous(-1, -1), at = tip;
+      int neighbours = 0;
+      for (const cv::Point& step : kNeighbours)
+        neighbours += inside(skeleton, tip + step) && skeleton(tip + step) != 0;
+      if (neighbours != 1) continue;
+      int traced = 0;
+      for (; traced < min_run; ++traced) {
+        cv::Point next(-1, -1);
+        for (const cv::Point& step : kNeighbours) {
+          const cv::Point candidate = at + step;
+          if (candidate != previous && inside(skeleton, candidate) && skeleton(candidate) != 0) next = candidate;
+        }
+        if (next.x < 0) break;
+        previous = at;
+        at = next;
+      }
+      if (traced < min_run) continue;  // a stub, not a wall
+      cv::Point2d direction(tip.x - at.x, tip.y - at.y);
+      direction /= std::hypot(direction.x, direction.y);
+
+      // Out of the wall, across the free run, to the obstacle at its end.
+      const std::vector<cv::Point> line = ray(cv::Point2d(tip), direction, 2 * (max_gap + min_run) + max_wall_thickness);
+      size_t i = 0;
+      while (i < line.size() && inside(free, line[i]) && free(line[i]) == 0) ++i;
+      const size_t gap_begin = i;
+      while (i < line.size() && inside(free, line[i]) && free(line[i]) != 0) ++i;
+      const size_t gap_end = i;
+      if (gap_end == gap_begin || gap_end - gap_begin > static_cast<size_t>(max_gap) || i >= line.size() ||
+          !inside(free, line[i]))
+        continue;
+      // Beyond: the wall line goes on.
+      bool continues = false;
+      int run = 0, free_run = 0;
+      for (; i < line.size() && inside(free, line[i]) && !continues; ++i) {
+        if (free(line[i]) != 0) {
+          run = 0;
+          if (++free_run > max_gap) break;
+          continue;
+        }
+        free_run = 0;
+        run = thin(line[i]) != 0 ? run + 1 : 0;
+        continues = run >= min_run;
+      }
+      if (!continues) continue;
+      cv::line(closed, line[gap_begin], line[gap_end - 1], cv::Scalar(0), 2);
+    }
+  return closed & free;
+}
+
 }  // namespace
 
 std::map<std::string, double> PassageSegmenter::defaultParameters() const {
@@ -46,6 +134,7 @@ std::map<std::string, double> PassageSegmenter::defaultParameters() const {
       {"max_passage_width", 2.0},
       {"min_room_area", 1.0},
       {"min_isolated_area", 0.25},
+      {"max_wall_gap", 2.5},
   };
 }
 
@@ -53,7 +142,11 @@ cv::Mat1i PassageSegmenter::segment(const SegmentationInput& input,
                                     const std::map<std::string, double>& parameters) const {
   const double ratio = parameters.at("passage_ratio");
   const double max_half_width = 0.5 * parameters.at("max_passage_width") / input.resolution;  // cells
-  const cv::Mat1b& free = input.free;
+  const int max_gap = static_cast<int>(std::lround(parameters.at("max_wall_gap") / input.resolution));
+  const cv::Mat1b free =
+      max_gap > 0 ? closeWallGaps(input.free, max_gap, static_cast<int>(std::lround(0.3 / input.resolution)),
+                                  static_cast<int>(std::lround(0.3 / input.resolution)))
+                  : input.free;
   cv::Mat1f distance;
   cv::distanceTransform(free, distance, cv::DIST_L2, cv::DIST_MASK_PRECISE);
 
@@ -113,6 +206,7 @@ cv::Mat1i PassageSegmenter::segment(const SegmentationInput& input,
   const double cell_area = input.resolution * input.resolution;
   mergeSmallRooms(free, parameters.at("min_room_area") / cell_area, parameters.at("min_isolated_area") / cell_area,
                   &labels);
+  spreadLabels(input.free, &labels);  // onto the closed gaps
   return labels;
 }
 

@@ -50,6 +50,37 @@ std::vector<double> widthUniformity(const SegmentedFloor& floor) {
   return uniformity;
 }
 
+// Per room: how many rooms lose their connection to the largest part of the graph without it (a hub's rooms).
+std::vector<int> roomsBehind(const std::vector<std::set<int>>& neighbours) {
+  const int count = static_cast<int>(neighbours.size());
+  std::vector<int> behind(count, 0);
+  const auto largestComponent = [&](int removed) {
+    std::vector<int> component(count, -1);
+    std::vector<int> sizes;
+    for (int start = 0; start < count; ++start) {
+      if (start == removed || component[start] >= 0) continue;
+      std::vector<int> stack = {start};
+      component[start] = static_cast<int>(sizes.size());
+      int size = 0;
+      while (!stack.empty()) {
+        const int room = stack.back();
+        stack.pop_back();
+        ++size;
+        for (const int other : neighbours[room])
+          if (other != removed && component[other] < 0) {
+            component[other] = component[start];
+            stack.push_back(other);
+          }
+      }
+      sizes.push_back(size);
+    }
+    return sizes.empty() ? 0 : *std::max_element(sizes.begin(), sizes.end());
+  };
+  const int whole = largestComponent(-1);
+  for (int room = 0; room < count; ++room) behind[room] = std::max(0, whole - 1 - largestComponent(room));
+  return behind;
+}
+
 double outlineLength(const common::Polygon& outline) {
   double length = 0.0;
   for (size_t i = 0; i < outline.size(); ++i) length += (outline[(i + 1) % outline.size()] - outline[i]).norm();
@@ -89,7 +120,8 @@ const std::vector<std::string>& roomFeatureNames() {
   static const std::vector<std::string> names = {
       "area",        "width",       "elongation",  "width_uniformity", "long_side",       "short_side",
       "aspect",      "rectangularity", "compactness", "passages",      "neighbours",      "relative_area",
-      "area_rank",   "largest_neighbour_ratio", "dead_end_neighbours", "passage_share"};
+      "area_rank",   "largest_neighbour_ratio", "dead_end_neighbours", "passage_share",
+      "neighbour_elongation", "neighbour_degree", "rooms_behind"};
   return names;
 }
 
@@ -112,8 +144,12 @@ cv::Mat1f roomFeatures(const SegmentedFloor& floor) {
       neighbours[passage.room_b - 1].insert(passage.room_a - 1);
     }
   }
-  std::vector<double> areas;
-  for (const Room& room : floor.rooms) areas.push_back(room.area);
+  std::vector<double> areas, elongations;
+  for (const Room& room : floor.rooms) {
+    areas.push_back(room.area);
+    elongations.push_back(room.width > 0.0 ? room.area / (room.width * room.width) : 0.0);
+  }
+  const std::vector<int> behind = roomsBehind(neighbours);
   std::vector<double> sorted = areas;
   std::sort(sorted.begin(), sorted.end());
   const double median = sorted[sorted.size() / 2];
@@ -124,10 +160,12 @@ cv::Mat1f roomFeatures(const SegmentedFloor& floor) {
     const cv::RotatedRect box = outline.size() >= 3 ? cv::minAreaRect(outline) : cv::RotatedRect();
     const double long_side = std::max(box.size.width, box.size.height);
     const double short_side = std::min(box.size.width, box.size.height);
-    double largest_neighbour = 0.0;
+    double largest_neighbour = 0.0, neighbour_elongation = 0.0, neighbour_degree = 0.0;
     int dead_ends = 0;
     for (const int other : neighbours[i]) {
       largest_neighbour = std::max(largest_neighbour, areas[other]);
+      neighbour_elongation = std::max(neighbour_elongation, elongations[other]);
+      neighbour_degree += static_cast<double>(neighbours[other].size()) / neighbours[i].size();
       dead_ends += passages[other] == 1;
     }
     const double perimeter = outlineLength(room.outline);
@@ -149,6 +187,9 @@ cv::Mat1f roomFeatures(const SegmentedFloor& floor) {
         room.area > 0.0 ? largest_neighbour / room.area : 0.0,
         static_cast<double>(dead_ends),
         perimeter > 0.0 ? passage_width[i] / perimeter : 0.0,
+        neighbour_elongation,
+        neighbour_degree,
+        static_cast<double>(behind[i]),
     };
     for (size_t j = 0; j < values.size(); ++j) features(static_cast<int>(i), static_cast<int>(j)) = static_cast<float>(values[j]);
   }

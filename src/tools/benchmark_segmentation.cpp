@@ -2,7 +2,9 @@
 // methods against ground truth with the survey's per-room recall and precision and Matthews' correlation
 // coefficient, and times them. Survey maps: DIR/NAME.png (free: pixels above 250, as the survey reads them) with
 // DIR/NAME_gt_segmentation.png; environments: every *.xml under DIR rendered with its doors open, the spaces as
-// ground truth.
+// ground truth; explored maps: exploration runs, the spaces carried into each map by the run's fit.
+#include <yaml-cpp/yaml.h>
+
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
@@ -13,7 +15,9 @@
 #include <vector>
 
 #include "hidden_rooms/common/command_line.h"
+#include "hidden_rooms/common/doors_file.h"
 #include "hidden_rooms/common/file_io.h"
+#include "hidden_rooms/common/geometry.h"
 #include "hidden_rooms/common/image_io.h"
 #include "hidden_rooms/common/input_error.h"
 #include "hidden_rooms/common/label_image.h"
@@ -33,6 +37,7 @@ namespace {
 struct Case {
   std::string name;
   common::OccupancyGrid map;
+  common::DoorsFile doors;  // closed doors (explored maps)
   cv::Mat1w truth;
   std::vector<segmentation::RoomKind> truth_kinds;  // per truth label; empty: the ground truth has no kinds
 };
@@ -74,21 +79,69 @@ std::vector<Case> surveyCases(const std::string& folder) {
   return cases;
 }
 
+// The labelled spaces of an environment: its ground truth (space labels, kinds) rendered with its doors open.
+struct SpaceTruth {
+  world::RenderedEnvironment rendered;
+  std::vector<segmentation::RoomKind> kinds;  // per space (label - 1)
+};
+
+SpaceTruth spaceTruth(const std::string& path) {
+  const world::Environment environment = world::loadEnvironment(path);
+  SpaceTruth truth{world::renderEnvironment(environment, {}), {}};
+  for (const world::Space& space : environment.spaces)
+    truth.kinds.push_back(space.label == "CORRIDOR" ? segmentation::RoomKind::kCorridor : segmentation::RoomKind::kRoom);
+  return truth;
+}
+
 std::vector<Case> environmentCases(const std::string& folder) {
   std::vector<Case> cases;
   for (const std::string& path : sortedFiles(folder, ".xml", true)) {
-    const world::Environment environment = world::loadEnvironment(path);
-    const world::RenderedEnvironment rendered = world::renderEnvironment(environment, {});
+    SpaceTruth truth = spaceTruth(path);
     Case each;
     each.name = fs::path(path).stem().string();
-    each.map = rendered.map;
-    each.truth = rendered.space_labels;
-    for (const world::Space& space : environment.spaces)
-      each.truth_kinds.push_back(space.label == "CORRIDOR" ? segmentation::RoomKind::kCorridor
-                                                            : segmentation::RoomKind::kRoom);
+    each.map = truth.rendered.map;
+    each.truth = truth.rendered.space_labels;
+    each.truth_kinds = truth.kinds;
     cases.push_back(each);
   }
   if (cases.empty()) throw common::InputError(folder, "holds no environment XML");
+  return cases;
+}
+
+// Exploration runs (explore_worlds' folders RUNS/NAME: map.yaml, doors.yaml, exploration.yaml with the fitted
+// world_from_map): each explored map with its closed doors, the spaces of environment NAME (an XML under one of
+// `world_folders`) carried into the map by the fit, on the map's free cells.
+std::vector<Case> exploredCases(const std::string& runs, const std::vector<std::string>& world_folders) {
+  std::map<std::string, std::string> worlds;
+  for (const std::string& folder : world_folders)
+    for (const std::string& path : sortedFiles(folder, ".xml", true)) worlds[fs::path(path).stem().string()] = path;
+  std::vector<Case> cases;
+  for (const std::string& fit_path : sortedFiles(runs, "/exploration.yaml", true)) {
+    const std::string folder = fs::path(fit_path).parent_path().string();
+    const std::string name = fs::path(folder).filename().string();
+    if (!worlds.count(name)) throw common::InputError(folder, "names no environment of --worlds");
+    const YAML::Node fit = common::loadYamlFile(fit_path, "exploration summary")["world_from_map"];
+    if (!fit || !fit.IsSequence() || fit.size() != 3) throw common::InputError(fit_path, "has no world_from_map");
+    const common::Pose2 world_from_map{fit[0].as<double>(), fit[1].as<double>(), fit[2].as<double>()};
+    const SpaceTruth truth = spaceTruth(worlds.at(name));
+    Case each;
+    each.name = name;
+    each.map = common::trinary(common::loadMap(folder + "/map.yaml"));
+    each.doors = common::loadDoors(folder + "/doors.yaml");
+    each.truth = cv::Mat1w::zeros(each.map.cells.size());
+    each.truth_kinds = truth.kinds;
+    const common::OccupancyGrid& world = truth.rendered.map;
+    for (int row = 0; row < each.map.height(); ++row)
+      for (int col = 0; col < each.map.width(); ++col) {
+        if (each.map.cells(row, col) != common::OccupancyGrid::kFree) continue;
+        const common::Point2 point = common::transformPoint(world_from_map, each.map.cellCentre(col, row));
+        int world_col = 0, world_row = 0;
+        if (world.cellOf(point, &world_col, &world_row))
+          each.truth(row, col) = truth.rendered.space_labels(world_row, world_col);
+      }
+    cases.push_back(each);
+  }
+  if (cases.empty()) throw common::InputError(runs, "holds no exploration run (NAME/exploration.yaml)");
   return cases;
 }
 
@@ -112,13 +165,16 @@ std::map<std::string, double> parseSettings(const std::vector<std::string>& sett
 
 int run(int argc, char** argv) {
   po::options_description options("Options");
-  std::string survey_dir, environments_dir, methods_text = "default", params_path, only_text, out_dir;
+  std::string survey_dir, environments_dir, explored_dir, worlds_text, methods_text = "default", params_path, only_text,
+      out_dir;
   std::vector<std::string> settings;
   bool per_map = false;
   segmentation::FloorSegmentationOptions floor_options;
   options.add_options()
       ("survey-maps", po::value(&survey_dir), "folder of NAME.png + NAME_gt_segmentation.png (the survey's maps)")
       ("environments", po::value(&environments_dir), "folder of environment XMLs (searched recursively)")
+      ("explored", po::value(&explored_dir), "folder of exploration runs (explore_worlds' NAME/ folders)")
+      ("worlds", po::value(&worlds_text), "comma-separated folders holding the explored environments' XMLs")
       ("methods", po::value(&methods_text)->default_value(methods_text), "comma-separated segmentation methods")
       ("params", po::value(&params_path), "parameter overrides: flat YAML of name: number")
       ("set", po::value(&settings)->composing(), "NAME=VALUE: one parameter override (repeatable, after --params)")
@@ -128,7 +184,8 @@ int run(int argc, char** argv) {
   po::variables_map values;
   if (!common::parseCommandLine(
           argc, argv,
-          "Usage: benchmark_segmentation [--survey-maps DIR] [--environments DIR] [--methods A,B]\n"
+          "Usage: benchmark_segmentation [--survey-maps DIR] [--environments DIR]\n"
+          "                              [--explored RUNS --worlds DIR,...] [--methods A,B]\n"
           "                              [--params FILE] [--set NAME=VALUE ...] [--only NAME,...] [--per-map]\n"
           "                              [--out DIR]\n"
           "Scores room segmentation methods against ground truth: the survey's per-room recall and precision\n"
@@ -137,8 +194,10 @@ int run(int argc, char** argv) {
           "given the right kind (corridor or room; a corridor: a space labelled CORRIDOR) and of corridors found.",
           options, {}, &values))
     return common::kExitOk;
-  if (survey_dir.empty() && environments_dir.empty())
-    throw common::InputError("command line", "give --survey-maps and/or --environments");
+  if (survey_dir.empty() && environments_dir.empty() && explored_dir.empty())
+    throw common::InputError("command line", "give --survey-maps, --environments and/or --explored");
+  if (!explored_dir.empty() && worlds_text.empty())
+    throw common::InputError("--explored", "needs --worlds, the folders of the explored environments' XMLs");
   std::map<std::string, double> overrides;
   if (!params_path.empty()) overrides = common::loadParameterFile(params_path);
   for (const auto& [name, value] : parseSettings(settings)) overrides[name] = value;
@@ -153,6 +212,8 @@ int run(int argc, char** argv) {
   if (!survey_dir.empty()) cases = surveyCases(survey_dir);
   if (!environments_dir.empty())
     for (Case& each : environmentCases(environments_dir)) cases.push_back(std::move(each));
+  if (!explored_dir.empty())
+    for (Case& each : exploredCases(explored_dir, common::splitList(worlds_text))) cases.push_back(std::move(each));
   if (!only.empty()) {
     for (const std::string& name : only)
       if (std::none_of(cases.begin(), cases.end(), [&](const Case& each) { return each.name == name; }))
@@ -188,7 +249,7 @@ int run(int argc, char** argv) {
     std::vector<double> seconds;
     for (const Case& each : cases) {
       const auto start = std::chrono::steady_clock::now();
-      const segmentation::SegmentedFloor floor = segmentation::segmentFloor(each.map, {}, {}, floor_options);
+      const segmentation::SegmentedFloor floor = segmentation::segmentFloor(each.map, each.doors, {}, floor_options);
       seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
       const segmentation::SegmentationScores scores = segmentation::scoreSegmentation(floor.labels, each.truth);
       segmentation::KindScores kinds;
