@@ -98,10 +98,18 @@ SegmentationScores scoreSegmentation(const cv::Mat1w& found, const cv::Mat1w& tr
   return scores;
 }
 
-KindScores scoreRoomKinds(const cv::Mat1w& found, const std::vector<RoomKind>& found_kinds, const cv::Mat1w& truth,
-                          const std::vector<RoomKind>& truth_kinds, int min_region_cells) {
+double LabelScores::recall(const std::string& label) const {
+  const auto found = per_label.find(label);
+  return found == per_label.end() || found->second.second == 0
+             ? 1.0
+             : static_cast<double>(found->second.first) / found->second.second;
+}
+
+LabelScores scoreRoomLabels(const cv::Mat1w& found, const std::vector<std::string>& found_labels,
+                            const cv::Mat1w& truth, const std::vector<std::string>& truth_labels,
+                            int min_region_cells) {
   if (found.size() != truth.size()) throw common::InputError("segmentation", "differs in size from the ground truth");
-  std::map<int, std::map<int, int>> overlap;  // found label -> truth label -> cells
+  std::map<int, std::map<int, int>> overlap;  // found room -> ground-truth room -> cells
   std::map<int, int> size;
   for (int row = 0; row < found.rows; ++row)
     for (int col = 0; col < found.cols; ++col) {
@@ -110,21 +118,23 @@ KindScores scoreRoomKinds(const cv::Mat1w& found, const std::vector<RoomKind>& f
       ++size[label];
       if (truth(row, col) != 0) ++overlap[label][truth(row, col)];
     }
-  KindScores scores;
-  for (const auto& [label, cells] : overlap) {
-    if (size[label] < min_region_cells) continue;
+  LabelScores scores;
+  for (const auto& [room, cells] : overlap) {
+    if (size[room] < min_region_cells) continue;
     int best = 0;
-    for (const auto& [truth_label, count] : cells)
-      if (best == 0 || count > cells.at(best)) best = truth_label;
-    if (label > static_cast<int>(found_kinds.size()) || best > static_cast<int>(truth_kinds.size()))
-      throw common::InputError("room kinds", "label " + std::to_string(std::max(label, best)) + " has no kind");
-    const RoomKind truth_kind = truth_kinds[best - 1], found_kind = found_kinds[label - 1];
+    for (const auto& [truth_room, count] : cells)
+      if (best == 0 || count > cells.at(best)) best = truth_room;
+    if (room > static_cast<int>(found_labels.size()))
+      throw common::InputError("segmentation", "room " + std::to_string(room) + " has no label");
+    if (best > static_cast<int>(truth_labels.size()))
+      throw common::InputError("ground truth", "room " + std::to_string(best) + " has no label");
+    const std::string& expected = truth_labels[best - 1];
+    if (expected.empty()) continue;
+    const bool right = found_labels[room - 1] == expected;
     ++scores.rooms;
-    scores.correct += truth_kind == found_kind;
-    if (truth_kind == RoomKind::kCorridor) {
-      ++scores.corridors;
-      scores.corridors_found += found_kind == RoomKind::kCorridor;
-    }
+    scores.correct += right;
+    ++scores.per_label[expected].second;
+    scores.per_label[expected].first += right;
   }
   return scores;
 }

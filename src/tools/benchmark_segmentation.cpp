@@ -39,7 +39,7 @@ struct Case {
   common::OccupancyGrid map;
   common::DoorsFile doors;  // closed doors (explored maps)
   cv::Mat1w truth;
-  std::vector<segmentation::RoomKind> truth_kinds;  // per truth label; empty: the ground truth has no kinds
+  std::vector<std::string> truth_kinds;  // per truth label, "corridor" or "room"; empty: none known
 };
 
 constexpr double kSurveyResolution = 0.05;  // metres per pixel of the survey's maps
@@ -82,14 +82,15 @@ std::vector<Case> surveyCases(const std::string& folder) {
 // The labelled spaces of an environment: its ground truth (space labels, kinds) rendered with its doors open.
 struct SpaceTruth {
   world::RenderedEnvironment rendered;
-  std::vector<segmentation::RoomKind> kinds;  // per space (label - 1)
+  std::vector<std::string> kinds;  // per space (label - 1): "corridor" or "room"
 };
 
 SpaceTruth spaceTruth(const std::string& path) {
   const world::Environment environment = world::loadEnvironment(path);
   SpaceTruth truth{world::renderEnvironment(environment, {}), {}};
   for (const world::Space& space : environment.spaces)
-    truth.kinds.push_back(space.label == "CORRIDOR" ? segmentation::RoomKind::kCorridor : segmentation::RoomKind::kRoom);
+    truth.kinds.push_back(segmentation::toString(space.label == "CORRIDOR" ? segmentation::RoomKind::kCorridor
+                                                                             : segmentation::RoomKind::kRoom));
   return truth;
 }
 
@@ -231,32 +232,31 @@ int run(int argc, char** argv) {
             << "  rec_mi  pre_mi  rec_ma  pre_ma     mcc  rooms  found  seconds    kind corridor\n";
   const auto printRow = [&](const std::string& method, const std::string& map,
                             const segmentation::SegmentationScores& scores, double seconds,
-                            const segmentation::KindScores& kinds) {
+                            const segmentation::LabelScores& kinds) {
     std::cout << std::left << std::setw(16) << method << std::setw(24) << map << std::right << std::setw(8)
               << scores.recall_micro << std::setw(8) << scores.precision_micro << std::setw(8) << scores.recall_macro
               << std::setw(8) << scores.precision_macro << std::setw(8) << scores.mcc << std::setw(7)
               << scores.truth_rooms << std::setw(7) << scores.found_rooms << std::setw(9) << seconds;
     if (kinds.rooms > 0)
-      std::cout << std::setw(8) << kinds.accuracy() << std::setw(9)
-                << (kinds.corridors > 0 ? static_cast<double>(kinds.corridors_found) / kinds.corridors : 1.0);
+      std::cout << std::setw(8) << kinds.accuracy() << std::setw(9) << kinds.recall("corridor");
     std::cout << "\n";
   };
   for (const auto& method : methods) {
     floor_options.method = method->name();
     floor_options.parameters = overrides;
     segmentation::SegmentationScores sum;
-    segmentation::KindScores kinds_sum;
+    segmentation::LabelScores kinds_sum;
     std::vector<double> seconds;
     for (const Case& each : cases) {
       const auto start = std::chrono::steady_clock::now();
       const segmentation::SegmentedFloor floor = segmentation::segmentFloor(each.map, each.doors, {}, floor_options);
       seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
       const segmentation::SegmentationScores scores = segmentation::scoreSegmentation(floor.labels, each.truth);
-      segmentation::KindScores kinds;
+      segmentation::LabelScores kinds;
       if (!each.truth_kinds.empty()) {
-        std::vector<segmentation::RoomKind> found_kinds;
-        for (const segmentation::Room& room : floor.rooms) found_kinds.push_back(room.kind);
-        kinds = segmentation::scoreRoomKinds(floor.labels, found_kinds, each.truth, each.truth_kinds);
+        std::vector<std::string> found_kinds;
+        for (const segmentation::Room& room : floor.rooms) found_kinds.push_back(segmentation::toString(room.kind));
+        kinds = segmentation::scoreRoomLabels(floor.labels, found_kinds, each.truth, each.truth_kinds);
       }
       if (!out_dir.empty()) {
         const std::string folder = out_dir + "/" + method->name();
@@ -274,8 +274,10 @@ int run(int argc, char** argv) {
       sum.found_rooms += scores.found_rooms;
       kinds_sum.rooms += kinds.rooms;
       kinds_sum.correct += kinds.correct;
-      kinds_sum.corridors += kinds.corridors;
-      kinds_sum.corridors_found += kinds.corridors_found;
+      for (const auto& [label, counts] : kinds.per_label) {
+        kinds_sum.per_label[label].first += counts.first;
+        kinds_sum.per_label[label].second += counts.second;
+      }
     }
     const double n = static_cast<double>(cases.size());
     sum.recall_micro /= n;

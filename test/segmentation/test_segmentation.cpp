@@ -161,6 +161,22 @@ TEST(SegmentationMetrics, HandMadeLabelImagesGiveTheSurveysScores) {
   EXPECT_THROW(scoreSegmentation(truth, cv::Mat1w::zeros(20, 40)), common::InputError);
 }
 
+TEST(SegmentationMetrics, LabelsAreScoredByTheGroundTruthRoomEachRoomOverlapsMost) {
+  cv::Mat1w truth = cv::Mat1w::zeros(20, 60);
+  truth(cv::Rect(0, 0, 20, 20)).setTo(1);
+  truth(cv::Rect(20, 0, 20, 20)).setTo(2);
+  truth(cv::Rect(40, 0, 20, 20)).setTo(3);
+  cv::Mat1w found = truth.clone();
+  found(cv::Rect(15, 0, 10, 20)).setTo(1);  // room 1 reaches into room 2, still mostly room 1
+  const LabelScores scores =
+      scoreRoomLabels(found, {"corridor", "room", "room"}, truth, {"corridor", "corridor", ""});
+  EXPECT_EQ(scores.rooms, 2);  // the third ground-truth room has no label
+  EXPECT_EQ(scores.correct, 1);
+  EXPECT_DOUBLE_EQ(scores.recall("corridor"), 0.5);
+  EXPECT_DOUBLE_EQ(scores.recall("office"), 1.0);
+  EXPECT_THROW(scoreRoomLabels(found, {"room"}, truth, {"room", "room", "room"}), common::InputError);
+}
+
 TEST(SegmentationMetrics, BorderImagesGiveOneRoomPerRegion) {
   cv::Mat1b image(30, 60, uchar(255));
   cv::line(image, {30, 0}, {30, 29}, cv::Scalar(0));

@@ -29,6 +29,8 @@ const std::string kPredict = PREDICT_ROOMS_OFFLINE_BIN;
 const std::string kExport = EXPORT_OCTOMAP_BIN;
 const std::string kSlice = SLICE_OCTOMAP_BIN;
 const std::string kSegment = SEGMENT_ROOMS_BIN;
+const std::string kScoreSegmentation = SCORE_SEGMENTATION_BIN;
+const std::string kTrainRoomTypes = TRAIN_ROOM_TYPES_BIN;
 
 std::string writeSynthetic(const std::string& dir, const std::string& xml) {
   const std::string path = dir + "/world.xml";
@@ -287,6 +289,49 @@ TEST(SegmentRoomsTool, SegmentsAPredictedCaseIntoRoomsGraphAndEnvironment) {
   EXPECT_EQ(rendered.exit_code, 0) << rendered.output;
 }
 
+TEST(ScoreSegmentationTool, ScoresARenderedEnvironmentsSegmentationAndItsLabels) {
+  const std::string dir = testing::makeTempDir("score_segmentation_tool");
+  const std::string world = writeSynthetic(dir, testing::corridorWithTwoRoomsXml());
+  ASSERT_EQ(runCommand(kRender + " " + world + " --out " + dir + "/rendered").exit_code, 0);
+  ASSERT_EQ(runCommand(kSegment + " " + dir + "/rendered/map.yaml --out " + dir + "/rooms").exit_code, 0);
+  const auto result = runCommand(kScoreSegmentation + " " + dir + "/rooms --truth " + dir +
+                                 "/rendered/spaces.png --environment " + world);
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const YAML::Node scores = YAML::Load(result.output);
+  EXPECT_EQ(scores["truth_rooms"].as<int>(), 3);
+  EXPECT_GT(scores["recall_micro"].as<double>(), 0.97);
+  EXPECT_GT(scores["precision_micro"].as<double>(), 0.97);
+  EXPECT_GT(scores["mcc"].as<double>(), 0.95);
+  EXPECT_EQ(scores["kinds"]["rooms"].as<int>(), 3);
+  EXPECT_TRUE(scores["types"]["accuracy"].IsDefined());
+  // The segmentation against itself, as a label image: perfect.
+  const auto same = runCommand(kScoreSegmentation + " " + dir + "/rooms/rooms.png --truth " + dir + "/rooms/rooms.png");
+  ASSERT_EQ(same.exit_code, 0) << same.output;
+  EXPECT_DOUBLE_EQ(YAML::Load(same.output)["mcc"].as<double>(), 1.0);
+
+  cv::imwrite(dir + "/small.png", cv::Mat1b::zeros(3, 3));
+  expectBadInput(kScoreSegmentation + " " + dir + "/rooms --truth " + dir + "/small.png", "the ground truth 3x3");
+  expectBadInput(kScoreSegmentation + " " + dir + "/rooms/rooms.png --truth " + dir + "/rendered/spaces.png" +
+                     " --environment " + world, "not of a label image");
+  expectBadInput(kScoreSegmentation + " " + dir + "/absent --truth " + dir + "/rendered/spaces.png", "absent");
+}
+
+// The shipped room type model is what train_room_types makes of the shared environments (training is seeded), so
+// it cannot go stale when the segmentation or the features change.
+TEST(TrainRoomTypesTool, TheShippedModelIsTheOneTrainedOnTheSharedEnvironments) {
+  HIDDEN_ROOMS_REQUIRE_SHARED_DATA();
+  const std::string dir = testing::makeTempDir("train_room_types_tool");
+  const auto result = runCommand(kTrainRoomTypes + " --environments " + testing::sharedDir() +
+                                 "/data/environments --out " + dir + "/room_types.yml");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_NE(result.output.find("corridor/room accuracy"), std::string::npos);
+  EXPECT_TRUE(testing::readFile(dir + "/room_types.yml") ==
+              testing::readFile(std::string(HIDDEN_ROOMS_SOURCE_DIR) + "/models/room_types.yml"))
+      << "models/room_types.yml is stale: train_room_types --environments ../shared/data/environments "
+         "--out models/room_types.yml";
+  expectBadInput(kTrainRoomTypes + " --environments " + dir + " --out " + dir + "/m.yml", "fewer environments");
+}
+
 TEST(SegmentRoomsTool, BadInputGivesAClearErrorAndWritesNothing) {
   const std::string dir = testing::makeTempDir("segment_tool_errors");
   const std::string input = syntheticCase(dir);
@@ -479,6 +524,7 @@ TEST(Tools, HelpExitsZero) {
   EXPECT_EQ(runCommand(kGenerate + " --help").exit_code, 0);
   EXPECT_EQ(runCommand(kPredict + " --help").exit_code, 0);
   EXPECT_EQ(runCommand(kSegment + " --help").exit_code, 0);
+  EXPECT_EQ(runCommand(kScoreSegmentation + " --help").exit_code, 0);
 }
 
 }  // namespace

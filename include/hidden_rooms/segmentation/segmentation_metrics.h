@@ -5,11 +5,11 @@
 
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <opencv2/core.hpp>
 
-#include "hidden_rooms/segmentation/room_graph.h"
 
 namespace hidden_rooms::segmentation {
 
@@ -37,19 +37,22 @@ struct SegmentationScores {
 SegmentationScores scoreSegmentation(const cv::Mat1w& found, const cv::Mat1w& truth,
                                      int min_region_cells = kSurveyMinRegionCells);
 
-// How well the rooms' kinds (and types) match the ground truth's: each found room (of at least `min_region_cells`
-// cells) takes the kind of the ground-truth room that overlaps it most; rooms overlapping none are not scored.
-struct KindScores {
-  int rooms = 0;           // found rooms scored
-  int correct = 0;         // with the ground truth's kind
-  int corridors = 0;       // found rooms whose ground truth is a corridor
-  int corridors_found = 0; // ... and that are called corridors
+// How well the rooms' labels (kinds, types) match the ground truth's: each found room (of at least
+// `min_region_cells` cells) takes the label of the ground-truth room that overlaps it most; rooms overlapping none,
+// or a ground-truth room with an empty label, are not scored.
+struct LabelScores {
+  int rooms = 0;    // found rooms scored
+  int correct = 0;  // with the ground truth's label
+  std::map<std::string, std::pair<int, int>> per_label;  // ground-truth label -> (correct, rooms)
   double accuracy() const { return rooms > 0 ? static_cast<double>(correct) / rooms : 0.0; }
+  // The share of the rooms labelled `label` in the ground truth that were found with it (1 without such rooms).
+  double recall(const std::string& label) const;
 };
-// `found_kinds[k - 1]`: the kind of found room k; `truth_kinds[k - 1]`: of ground-truth room k. Throws InputError
-// when the images differ in size or a label has no kind.
-KindScores scoreRoomKinds(const cv::Mat1w& found, const std::vector<RoomKind>& found_kinds, const cv::Mat1w& truth,
-                          const std::vector<RoomKind>& truth_kinds, int min_region_cells = kSurveyMinRegionCells);
+// `found_labels[k - 1]`: the label of found room k; `truth_labels[k - 1]`: of ground-truth room k. Throws InputError
+// when the images differ in size or a room has no label.
+LabelScores scoreRoomLabels(const cv::Mat1w& found, const std::vector<std::string>& found_labels,
+                            const cv::Mat1w& truth, const std::vector<std::string>& truth_labels,
+                            int min_region_cells = kSurveyMinRegionCells);
 
 // The ground truth of the survey's test maps: an 8-bit image with the room borders drawn in black; each
 // 8-connected region of pixels above 250 is a room (labels 1..N), the rest 0.
