@@ -134,6 +134,7 @@ std::map<std::string, double> PassageSegmenter::defaultParameters() const {
       {"max_passage_width", 2.0},
       {"min_room_area", 1.0},
       {"min_isolated_area", 0.25},
+      {"min_room_width", 0.5},
       {"max_wall_gap", 2.5},
   };
 }
@@ -204,8 +205,11 @@ cv::Mat1i PassageSegmenter::segment(const SegmentationInput& input,
   cv::Mat1i labels(free.size(), 0);
   for (const int cell : order) labels(cell / cols, cell % cols) = basins.root(cell) + 1;
   const double cell_area = input.resolution * input.resolution;
-  mergeSmallRooms(free, parameters.at("min_room_area") / cell_area, parameters.at("min_isolated_area") / cell_area,
-                  &labels);
+  RoomLimits limits;
+  limits.min_area = parameters.at("min_room_area") / cell_area;
+  limits.min_half_width = 0.5 * parameters.at("min_room_width") / input.resolution;
+  limits.min_isolated_area = parameters.at("min_isolated_area") / cell_area;
+  mergeSmallRooms(free, distance, limits, &labels);
   spreadLabels(input.free, &labels);  // onto the closed gaps
   return labels;
 }

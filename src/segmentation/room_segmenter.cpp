@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <deque>
+#include <algorithm>
 #include <functional>
 #include <limits>
 #include <set>
@@ -109,19 +110,20 @@ void relabelConsecutively(cv::Mat1i* labels) {
   }
 }
 
-void mergeSmallRooms(const cv::Mat1b& free, double min_area_cells, double min_isolated_cells, cv::Mat1i* labels) {
+void mergeSmallRooms(const cv::Mat1b& free, const cv::Mat1f& distance, const RoomLimits& limits, cv::Mat1i* labels) {
   relabelConsecutively(labels);
   double max_label = 0.0;
   cv::minMaxLoc(*labels, nullptr, &max_label);
   const int count = static_cast<int>(max_label);
-  // The room graph once: areas, and per pair of rooms the cell pairs they share (8-neighbourhood).
-  std::vector<double> area(count + 1, 0.0);
+  // The room graph once: areas, peaks, and per pair of rooms the cell pairs they share (8-neighbourhood).
+  std::vector<double> area(count + 1, 0.0), peak(count + 1, 0.0);
   std::vector<std::map<int, double>> border(count + 1);
   for (int row = 0; row < labels->rows; ++row)
     for (int col = 0; col < labels->cols; ++col) {
       const int label = (*labels)(row, col);
       if (label == 0) continue;
       ++area[label];
+      peak[label] = std::max(peak[label], static_cast<double>(distance(row, col)));
       // Forward half of the neighbourhood, so that every pair of cells is counted once.
       static const cv::Point kForward[] = {{1, 0}, {-1, 1}, {0, 1}, {1, 1}};
       for (const cv::Point& step : kForward) {
@@ -133,12 +135,11 @@ void mergeSmallRooms(const cv::Mat1b& free, double min_area_cells, double min_is
         ++border[other][label];
       }
     }
-  // Merge the smallest room below the limit into its longest-border neighbour, repeatedly, so that a chain of small
-  // rooms ends in a large one.
+  const auto tooSmall = [&](int label) { return area[label] < limits.min_area || peak[label] < limits.min_half_width; };
   std::vector<int> merged_into(count + 1, 0);  // 0: still a room; -1: dropped
   std::set<std::pair<double, int>> small;
   for (int label = 1; label <= count; ++label)
-    if (area[label] > 0 && area[label] < min_area_cells) small.emplace(area[label], label);
+    if (area[label] > 0 && tooSmall(label)) small.emplace(area[label], label);
   while (!small.empty()) {
     const int label = small.begin()->second;
     small.erase(small.begin());
@@ -146,13 +147,14 @@ void mergeSmallRooms(const cv::Mat1b& free, double min_area_cells, double min_is
     for (const auto& [other, length] : border[label])
       if (target == 0 || length > border[label][target]) target = other;
     if (target == 0) {  // no neighbour to join
-      if (area[label] < min_isolated_cells) merged_into[label] = -1;
+      if (area[label] < limits.min_isolated_area || peak[label] < limits.min_half_width) merged_into[label] = -1;
       continue;
     }
     merged_into[label] = target;
     small.erase({area[target], target});
     area[target] += area[label];
-    if (area[target] < min_area_cells) small.emplace(area[target], target);
+    peak[target] = std::max(peak[target], peak[label]);
+    if (tooSmall(target)) small.emplace(area[target], target);
     for (const auto& [other, length] : border[label]) {
       border[other].erase(label);
       if (other == target) continue;

@@ -40,6 +40,7 @@ struct Case {
   common::DoorsFile doors;  // closed doors (explored maps)
   cv::Mat1w truth;
   std::vector<std::string> truth_kinds;  // per truth label, "corridor" or "room"; empty: none known
+  double free_iou = 1.0;  // explored maps: how well the map agrees with the building (exploration.yaml)
 };
 
 constexpr double kSurveyResolution = 0.05;  // metres per pixel of the survey's maps
@@ -109,9 +110,10 @@ std::vector<Case> environmentCases(const std::string& folder) {
   return cases;
 }
 
-// Exploration runs (explore_worlds' folders RUNS/NAME: map.yaml, doors.yaml, exploration.yaml with the fitted
-// world_from_map): each explored map with its closed doors, the spaces of environment NAME (an XML under one of
-// `world_folders`) carried into the map by the fit, on the map's free cells.
+// Exploration runs (folders RUNS/NAME of explore_worlds or of the closed-door corpus's store: map.yaml, doors.yaml,
+// exploration.yaml with the fitted world_from_map): each explored map with its closed doors (none when the run's
+// run.yaml says no door was closed: the corpus store's doors.yaml then lists open doors), the spaces of environment
+// NAME (an XML under one of `world_folders`) carried into the map by the fit, on the map's free cells.
 std::vector<Case> exploredCases(const std::string& runs, const std::vector<std::string>& world_folders) {
   std::map<std::string, std::string> worlds;
   for (const std::string& folder : world_folders)
@@ -121,14 +123,18 @@ std::vector<Case> exploredCases(const std::string& runs, const std::vector<std::
     const std::string folder = fs::path(fit_path).parent_path().string();
     const std::string name = fs::path(folder).filename().string();
     if (!worlds.count(name)) throw common::InputError(folder, "names no environment of --worlds");
-    const YAML::Node fit = common::loadYamlFile(fit_path, "exploration summary")["world_from_map"];
+    const YAML::Node summary = common::loadYamlFile(fit_path, "exploration summary");
+    const YAML::Node fit = summary["world_from_map"];
     if (!fit || !fit.IsSequence() || fit.size() != 3) throw common::InputError(fit_path, "has no world_from_map");
     const common::Pose2 world_from_map{fit[0].as<double>(), fit[1].as<double>(), fit[2].as<double>()};
     const SpaceTruth truth = spaceTruth(worlds.at(name));
     Case each;
     each.name = name;
+    if (summary["free_iou"]) each.free_iou = summary["free_iou"].as<double>();
     each.map = common::trinary(common::loadMap(folder + "/map.yaml"));
-    each.doors = common::loadDoors(folder + "/doors.yaml");
+    const bool doors_closed = !common::isFile(folder + "/run.yaml") ||
+                              common::loadYamlFile(folder + "/run.yaml", "run summary")["closed"].as<std::string>("") != "";
+    if (doors_closed) each.doors = common::loadDoors(folder + "/doors.yaml");
     each.truth = cv::Mat1w::zeros(each.map.cells.size());
     each.truth_kinds = truth.kinds;
     const common::OccupancyGrid& world = truth.rendered.map;
@@ -170,18 +176,23 @@ int run(int argc, char** argv) {
       out_dir;
   std::vector<std::string> settings;
   bool per_map = false;
+  double min_free_iou = 0.0;
   segmentation::FloorSegmentationOptions floor_options;
   options.add_options()
       ("survey-maps", po::value(&survey_dir), "folder of NAME.png + NAME_gt_segmentation.png (the survey's maps)")
       ("environments", po::value(&environments_dir), "folder of environment XMLs (searched recursively)")
       ("explored", po::value(&explored_dir), "folder of exploration runs (explore_worlds' NAME/ folders)")
       ("worlds", po::value(&worlds_text), "comma-separated folders holding the explored environments' XMLs")
+      ("min-free-iou", po::value(&min_free_iou)->default_value(0.0),
+       "leave out exploration runs whose map agrees less with the building (exploration.yaml's free_iou)")
       ("methods", po::value(&methods_text)->default_value(methods_text), "comma-separated segmentation methods")
       ("params", po::value(&params_path), "parameter overrides: flat YAML of name: number")
       ("set", po::value(&settings)->composing(), "NAME=VALUE: one parameter override (repeatable, after --params)")
       ("only", po::value(&only_text), "comma-separated map names to score (default: all)")
       ("per-map", po::bool_switch(&per_map), "print every map's scores, not only the means")
-      ("out", po::value(&out_dir), "folder for each map's labels (METHOD/NAME.png) and pictures (NAME_preview.png)");
+      ("out", po::value(&out_dir),
+       "folder for each map's labels (METHOD/NAME.png), pictures (METHOD/NAME_preview.png) and ground truth "
+       "(truth/NAME.png)");
   po::variables_map values;
   if (!common::parseCommandLine(
           argc, argv,
@@ -225,7 +236,18 @@ int run(int argc, char** argv) {
                                }),
                 cases.end());
   }
-  if (!out_dir.empty()) common::createOutputDirectory(out_dir);
+  // Explored maps that agree less with the building than --min-free-iou (SLAM drift that the run's one rigid fit
+  // cannot follow, so that the spaces land off their rooms) are left out.
+  const size_t before = cases.size();
+  cases.erase(std::remove_if(cases.begin(), cases.end(), [&](const Case& each) { return each.free_iou < min_free_iou; }),
+              cases.end());
+  if (cases.size() < before)
+    std::cout << "left out " << before - cases.size() << " exploration runs with free_iou below " << min_free_iou << "\n";
+  if (cases.empty()) throw common::InputError("--min-free-iou", "leaves no map");
+  if (!out_dir.empty()) {
+    common::createOutputDirectory(out_dir + "/truth");
+    for (const Case& each : cases) common::saveLabelImage(each.truth, out_dir + "/truth/" + each.name + ".png");
+  }
 
   std::cout << std::fixed << std::setprecision(3);
   std::cout << std::left << std::setw(16) << "method" << std::setw(24) << "map" << std::right

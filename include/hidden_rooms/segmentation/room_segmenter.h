@@ -53,11 +53,19 @@ cv::Mat1w segmentRooms(const RoomSegmenter& method, const SegmentationInput& inp
 // the label that reaches it first: borders fall halfway between the seeds). Free cells no label reaches stay 0.
 void spreadLabels(const cv::Mat1b& free, cv::Mat1i* labels);
 
-// Merges every room smaller than `min_area_cells` into the neighbouring room it shares the longest border with
-// (8-neighbourhood through free cells); a small room without neighbours stays a room when it has at least
-// `min_isolated_cells` cells, else it is dropped (label 0). Then numbers the labels 1..N in order of first
-// appearance (row-major).
-void mergeSmallRooms(const cv::Mat1b& free, double min_area_cells, double min_isolated_cells, cv::Mat1i* labels);
+// What a room needs to be one (cells).
+struct RoomLimits {
+  double min_area = 0.0;        // smaller rooms join a neighbour
+  double min_half_width = 0.0;  // so do rooms whose largest distance to a wall is below this
+  double min_isolated_area = 0.0;  // a room too small or narrow without neighbours stays one with this area
+};
+
+// Merges every room below `limits` (area, or largest value of `distance` over its cells) into the neighbouring room
+// it shares the longest border with (8-neighbourhood through free cells), smallest first, so that a chain of small
+// rooms ends in a large one; a small room without neighbours stays a room when it has at least
+// `limits.min_isolated_area` cells and is not too narrow, else it is dropped (label 0). Then numbers the labels
+// 1..N in order of first appearance (row-major).
+void mergeSmallRooms(const cv::Mat1b& free, const cv::Mat1f& distance, const RoomLimits& limits, cv::Mat1i* labels);
 
 // Numbers the labels 1..N in order of first appearance (row-major), 0 staying 0.
 void relabelConsecutively(cv::Mat1i* labels);

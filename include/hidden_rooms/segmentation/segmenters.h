@@ -12,9 +12,9 @@ namespace hidden_rooms::segmentation {
 // "default": rooms are the basins of the free space's distance to the nearest wall, split where the passage
 // between two basins is a constriction: narrower than a door (`max_passage_width`) and narrower than
 // `passage_ratio` times the smaller basin's widest point. Flooding the distance from its maxima downwards, two
-// basins that meet at a wider passage become one room; rooms below `min_room_area` join the neighbour they share
-// the longest border with; a free region without neighbours is a room unless a robot cannot stand in it (below
-// `min_isolated_area`). Before flooding, openings of straight walls up to `max_wall_gap` wide are closed where the
+// basins that meet at a wider passage become one room; rooms below `min_room_area`, or narrower than
+// `min_room_width` (a robot cannot enter them), join the neighbour they share the longest border with; a free region
+// without neighbours is a room unless a robot cannot enter or stand in it (below `min_isolated_area`). Before flooding, openings of straight walls up to `max_wall_gap` wide are closed where the
 // wall line goes on beyond them (a room's open front on a corridor's wall line).
 class PassageSegmenter : public RoomSegmenter {
  public:
