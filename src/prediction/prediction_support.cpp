@@ -124,6 +124,7 @@ void checkDoorsInsideMap(const common::OccupancyGrid& map, const common::DoorsFi
 common::OccupancyGrid insertRooms(const common::OccupancyGrid& map, const common::DoorsFile& doors,
                                   const std::vector<RoomPrediction>& rooms) {
   common::OccupancyGrid completed = map;
+  completed.cells = map.cells.clone();  // the input map stays as it is
   cv::Mat1b all_rooms = cv::Mat1b::zeros(map.cells.size());
   for (const RoomPrediction& room : rooms)
     if (room.placed) all_rooms |= room.mask;

@@ -184,10 +184,19 @@ TEST(Prediction, InsertionFillsTheRoomAndOpensItsDoor) {
   ASSERT_TRUE(completed.cellOf(common::Point2(5.0, 5.0), &col, &row));
   const cv::Mat1b reached = common::reachableFreeCells(completed, col, row);
   EXPECT_GT(cv::countNonZero(reached & result.rooms[0].mask), 0.9 * cv::countNonZero(result.rooms[0].mask));
-  // Nothing known in the input is lost except the door's own cells.
-  EXPECT_LT(cv::countNonZero((request.map.cells == common::OccupancyGrid::kOccupied) &
-                             (completed.cells == common::OccupancyGrid::kFree)),
-            30);
+  // Nothing known in the input is lost except the door's own cells (within its half width of its centre, plus a
+  // cell), and the input map is left as it was.
+  std::vector<cv::Point> opened;
+  cv::findNonZero((request.map.cells == common::OccupancyGrid::kOccupied) &
+                      (completed.cells == common::OccupancyGrid::kFree),
+                  opened);
+  EXPECT_GT(opened.size(), 0u);
+  const common::MapDoor& door = request.doors.doors[0];
+  for (const cv::Point& cell : opened)
+    EXPECT_LE((request.map.cellCentre(cell.x, cell.y) - door.position).norm(),
+              0.5 * door.width + 1.5 * request.map.resolution);
+  EXPECT_EQ(cv::countNonZero((request.map.cells == common::OccupancyGrid::kUnknown) & result.rooms[0].mask),
+            cv::countNonZero(result.rooms[0].mask));
 }
 
 // Two overlapping square rooms on a 20 x 10 unknown map (0.1 m cells): room 1 covers columns 2..11, room 2
@@ -203,8 +212,8 @@ OverlappingRooms overlappingRooms() {
   s.map.cells = cv::Mat_<int8_t>(10, 20, common::OccupancyGrid::kUnknown);
   s.map.cells(cv::Rect(0, 0, 20, 1)).setTo(common::OccupancyGrid::kFree);
   s.map.resolution = 0.1;
-  s.doors.doors = {{1, common::Point2(0.2, 0.5), 0.9, common::DoorOrientation::kAlongY},
-                   {2, common::Point2(1.8, 0.5), 0.9, common::DoorOrientation::kAlongY}};
+  s.doors.doors = {{1, common::Point2(0.2, 0.5), 0.9, common::DoorOrientation::kAlongY, std::nullopt},
+                   {2, common::Point2(1.8, 0.5), 0.9, common::DoorOrientation::kAlongY, std::nullopt}};
   for (int k = 0; k < 2; ++k) {
     RoomPrediction room;
     room.door_id = k + 1;
