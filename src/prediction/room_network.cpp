@@ -7,16 +7,10 @@
 #include <opencv2/dnn.hpp>
 #include <opencv2/imgproc.hpp>
 
-// The ONNX file, built into the library: CMake sets HIDDEN_ROOMS_ROOM_NETWORK_ONNX to its path (and rebuilds this
-// file when it changes), so that no file has to be found at run time.
-asm(".pushsection .rodata\n"
-    ".balign 16\n"
-    "hidden_rooms_room_network_onnx:\n"
-    ".incbin \"" HIDDEN_ROOMS_ROOM_NETWORK_ONNX "\"\n"
-    "hidden_rooms_room_network_onnx_end:\n"
-    ".popsection\n");
-extern "C" const char hidden_rooms_room_network_onnx[];
-extern "C" const char hidden_rooms_room_network_onnx_end[];
+#include "hidden_rooms/common/embedded_file.h"
+
+// The ONNX file, built into the library (CMake sets HIDDEN_ROOMS_ROOM_NETWORK_ONNX to its path).
+HIDDEN_ROOMS_EMBED_FILE(hidden_rooms_room_network_onnx, HIDDEN_ROOMS_ROOM_NETWORK_ONNX);
 
 namespace hidden_rooms::prediction {
 namespace {

@@ -39,12 +39,6 @@ class Basins {
   std::vector<float> peak_;
 };
 
-const cv::Point kNeighbours[] = {{-1, -1}, {0, -1}, {1, -1}, {-1, 0}, {1, 0}, {-1, 1}, {0, 1}, {1, 1}};
-
-bool inside(const cv::Mat& image, const cv::Point& cell) {
-  return cell.x >= 0 && cell.y >= 0 && cell.x < image.cols && cell.y < image.rows;
-}
-
 // The cells of the line from `from` along `direction` (unit), one per step of a cell, at most `steps`.
 std::vector<cv::Point> ray(const cv::Point2d& from, const cv::Point2d& direction, int steps) {
   std::vector<cv::Point> cells;
@@ -79,15 +73,15 @@ cv::Mat1b closeWallGaps(const cv::Mat1b& free, int max_gap, int min_run, int max
       // A tip: one skeleton neighbour. Its direction: from the skeleton cell min_run steps back to the tip.
       cv::Point tip(col, row), previous(-1, -1), at = tip;
       int neighbours = 0;
-      for (const cv::Point& step : kNeighbours)
-        neighbours += inside(skeleton, tip + step) && skeleton(tip + step) != 0;
+      for (const cv::Point& step : kNeighbours8)
+        neighbours += insideImage(skeleton, tip + step) && skeleton(tip + step) != 0;
       if (neighbours != 1) continue;
       int traced = 0;
       for (; traced < min_run; ++traced) {
         cv::Point next(-1, -1);
-        for (const cv::Point& step : kNeighbours) {
+        for (const cv::Point& step : kNeighbours8) {
           const cv::Point candidate = at + step;
-          if (candidate != previous && inside(skeleton, candidate) && skeleton(candidate) != 0) next = candidate;
+          if (candidate != previous && insideImage(skeleton, candidate) && skeleton(candidate) != 0) next = candidate;
         }
         if (next.x < 0) break;
         previous = at;
@@ -100,17 +94,17 @@ cv::Mat1b closeWallGaps(const cv::Mat1b& free, int max_gap, int min_run, int max
       // Out of the wall, across the free run, to the obstacle at its end.
       const std::vector<cv::Point> line = ray(cv::Point2d(tip), direction, 2 * (max_gap + min_run) + max_wall_thickness);
       size_t i = 0;
-      while (i < line.size() && inside(free, line[i]) && free(line[i]) == 0) ++i;
+      while (i < line.size() && insideImage(free, line[i]) && free(line[i]) == 0) ++i;
       const size_t gap_begin = i;
-      while (i < line.size() && inside(free, line[i]) && free(line[i]) != 0) ++i;
+      while (i < line.size() && insideImage(free, line[i]) && free(line[i]) != 0) ++i;
       const size_t gap_end = i;
       if (gap_end == gap_begin || gap_end - gap_begin > static_cast<size_t>(max_gap) || i >= line.size() ||
-          !inside(free, line[i]))
+          !insideImage(free, line[i]))
         continue;
       // Beyond: the wall line goes on.
       bool continues = false;
       int run = 0, free_run = 0;
-      for (; i < line.size() && inside(free, line[i]) && !continues; ++i) {
+      for (; i < line.size() && insideImage(free, line[i]) && !continues; ++i) {
         if (free(line[i]) != 0) {
           run = 0;
           if (++free_run > max_gap) break;

@@ -81,11 +81,10 @@ void spreadLabels(const cv::Mat1b& free, cv::Mat1i* labels) {
   for (int row = 0; row < labels->rows; ++row)
     for (int col = 0; col < labels->cols; ++col)
       if ((*labels)(row, col) != 0) queue.emplace_back(col, row);
-  static const cv::Point kSteps[] = {{-1, -1}, {0, -1}, {1, -1}, {-1, 0}, {1, 0}, {-1, 1}, {0, 1}, {1, 1}};
   while (!queue.empty()) {
     const cv::Point cell = queue.front();
     queue.pop_front();
-    for (const cv::Point& step : kSteps) {
+    for (const cv::Point& step : kNeighbours8) {
       const cv::Point next = cell + step;
       if (next.x < 0 || next.y < 0 || next.x >= free.cols || next.y >= free.rows) continue;
       if (free(next) == 0 || (*labels)(next) != 0) continue;

@@ -8,18 +8,11 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/ml.hpp>
 
+#include "hidden_rooms/common/embedded_file.h"
 #include "hidden_rooms/common/input_error.h"
 
-// The shipped model, built into the library: CMake sets HIDDEN_ROOMS_ROOM_TYPES_MODEL to its path (and rebuilds
-// this file when it changes), so that no file has to be found at run time.
-asm(".pushsection .rodata\n"
-    "hidden_rooms_room_types_model:\n"
-    ".incbin \"" HIDDEN_ROOMS_ROOM_TYPES_MODEL "\"\n"
-    "hidden_rooms_room_types_model_end:\n"
-    ".byte 0\n"
-    ".popsection\n");
-extern "C" const char hidden_rooms_room_types_model[];
-extern "C" const char hidden_rooms_room_types_model_end[];
+// The shipped model, built into the library (CMake sets HIDDEN_ROOMS_ROOM_TYPES_MODEL to its path).
+HIDDEN_ROOMS_EMBED_FILE(hidden_rooms_room_types_model, HIDDEN_ROOMS_ROOM_TYPES_MODEL);
 
 namespace hidden_rooms::segmentation {
 

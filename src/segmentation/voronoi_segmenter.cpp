@@ -13,12 +13,6 @@ namespace hidden_rooms::segmentation {
 
 namespace {
 
-const cv::Point kNeighbours[] = {{-1, -1}, {0, -1}, {1, -1}, {-1, 0}, {1, 0}, {-1, 1}, {0, 1}, {1, 1}};
-
-bool inside(const cv::Mat& image, cv::Point cell) {
-  return cell.x >= 0 && cell.y >= 0 && cell.x < image.cols && cell.y < image.rows;
-}
-
 int squaredLength(cv::Point vector) { return vector.x * vector.x + vector.y * vector.y; }
 
 // The boundary cells of the free space (every cell of its contours and its holes' contours, in contour order).
@@ -46,7 +40,7 @@ cv::Mat1b voronoiGraph(const cv::Mat1b& free, const std::vector<std::vector<cv::
 
   const auto away = [&](const cv::Point2f& point) {
     const cv::Point cell(static_cast<int>(point.x), static_cast<int>(point.y));  // truncated, as the survey does
-    return inside(away_from_walls, cell) && away_from_walls(cell) != 0;
+    return insideImage(away_from_walls, cell) && away_from_walls(cell) != 0;
   };
   cv::Mat1b graph = cv::Mat1b::zeros(free.size());
   for (const std::vector<cv::Point2f>& facet : facets)
@@ -61,7 +55,7 @@ cv::Mat1b voronoiGraph(const cv::Mat1b& free, const std::vector<std::vector<cv::
 
 int graphNeighbours(const cv::Mat1b& graph, cv::Point cell) {
   int count = 0;
-  for (const cv::Point& step : kNeighbours) count += inside(graph, cell + step) && graph(cell + step) != 0;
+  for (const cv::Point& step : kNeighbours8) count += insideImage(graph, cell + step) && graph(cell + step) != 0;
   return count;
 }
 
@@ -84,8 +78,8 @@ void pruneSideBranches(cv::Mat1b* graph) {
     ends.pop_back();
     if ((*graph)(cell) == 0 || node(cell) != 0 || graphNeighbours(*graph, cell) > 1) continue;
     (*graph)(cell) = 0;
-    for (const cv::Point& step : kNeighbours)
-      if (inside(*graph, cell + step) && (*graph)(cell + step) != 0) ends.push_back(cell + step);
+    for (const cv::Point& step : kNeighbours8)
+      if (insideImage(*graph, cell + step) && (*graph)(cell + step) != 0) ends.push_back(cell + step);
   }
 }
 
@@ -115,9 +109,9 @@ std::vector<cv::Point> criticalPoints(const cv::Mat1b& graph, const cv::Mat1b& c
       for (int rings = 0; rings < max_rings && counted <= wanted && !ring.empty(); ++rings) {
         std::vector<cv::Point> next;
         for (const cv::Point& cell : ring)
-          for (const cv::Point& step : kNeighbours) {
+          for (const cv::Point& step : kNeighbours8) {
             const cv::Point neighbour = cell + step;
-            if (!inside(state, neighbour)) continue;
+            if (!insideImage(state, neighbour)) continue;
             if (state(neighbour) == kFree) {
               state(neighbour) = kTakenThisRing;
               next.push_back(neighbour);
@@ -317,9 +311,9 @@ class RoomMerger {
         const int label = padded(row, col);
         int touched[8];
         int count = 0;
-        for (const cv::Point& step : kNeighbours) {
+        for (const cv::Point& step : kNeighbours8) {
           const cv::Point neighbour(col + step.x, row + step.y);
-          if (!inside(padded, neighbour)) continue;
+          if (!insideImage(padded, neighbour)) continue;
           const int other = padded(neighbour);
           if (other > 0 && other != label && std::find(touched, touched + count, other) == touched + count)
             touched[count++] = other;

@@ -49,6 +49,12 @@ cv::Mat1w segmentRooms(const RoomSegmenter& method, const SegmentationInput& inp
 
 // --- Building blocks shared by the methods ---
 
+// The eight neighbours of a cell, row by row.
+inline const cv::Point kNeighbours8[] = {{-1, -1}, {0, -1}, {1, -1}, {-1, 0}, {1, 0}, {-1, 1}, {0, 1}, {1, 1}};
+inline bool insideImage(const cv::Mat& image, const cv::Point& cell) {
+  return cell.x >= 0 && cell.y >= 0 && cell.x < image.cols && cell.y < image.rows;
+}
+
 // Grows the labelled cells of `labels` into the unlabelled free cells (8-connected breadth-first, each cell taking
 // the label that reaches it first: borders fall halfway between the seeds). Free cells no label reaches stay 0.
 void spreadLabels(const cv::Mat1b& free, cv::Mat1i* labels);
