@@ -216,6 +216,7 @@ hidden_rooms::SegmentedRoom toRos(const segmentation::Room& room) {
   message.predicted = room.predicted;
   message.area = room.area;
   message.width = room.width;
+  message.mean_width = room.mean_width;
   message.centroid = toRos(room.centroid, 0.0);
   for (const common::Point2& vertex : room.outline) message.outline.push_back(toRos(vertex, 0.0));
   return message;

@@ -110,6 +110,7 @@ std::string floorToYaml(const SegmentedFloor& floor) {
     out << YAML::Key << "predicted" << YAML::Value << room.predicted;
     out << YAML::Key << "area" << YAML::Value << room.area;
     out << YAML::Key << "width" << YAML::Value << room.width;
+    out << YAML::Key << "mean_width" << YAML::Value << room.mean_width;
     out << YAML::Key << "centroid" << YAML::Value;
     emitPoint(&out, room.centroid);
     out << YAML::Key << "outline" << YAML::Value << YAML::BeginSeq;

@@ -75,6 +75,7 @@ Room describeRoom(const common::OccupancyGrid& map, const cv::Mat1w& labels, int
   double max_distance = 0.0;
   cv::minMaxLoc(distance, nullptr, &max_distance);
   room.width = 2.0 * max_distance * map.resolution;
+  room.mean_width = 2.0 * cv::mean(distance, local)[0] * map.resolution;
 
   std::vector<std::vector<cv::Point>> contours;
   cv::findContours(local, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_SIMPLE);

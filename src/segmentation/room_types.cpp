@@ -18,31 +18,6 @@ namespace hidden_rooms::segmentation {
 
 namespace {
 
-// Per room: the mean of the distance to its border over its cells, divided by the largest (1: a uniform width).
-std::vector<double> widthUniformity(const SegmentedFloor& floor) {
-  std::vector<double> uniformity(floor.rooms.size(), 0.0);
-  std::vector<cv::Rect> boxes(floor.rooms.size());
-  for (int row = 0; row < floor.labels.rows; ++row)
-    for (int col = 0; col < floor.labels.cols; ++col) {
-      const int label = floor.labels(row, col);
-      if (label == 0) continue;
-      const cv::Rect cell(col, row, 1, 1);
-      boxes[label - 1] = boxes[label - 1].empty() ? cell : (boxes[label - 1] | cell);
-    }
-  for (size_t i = 0; i < floor.rooms.size(); ++i) {
-    const cv::Rect& box = boxes[i];
-    if (box.empty()) continue;
-    cv::Mat1b local(box.height + 2, box.width + 2, uchar(0));
-    cv::Mat1b(floor.labels(box) == static_cast<int>(i) + 1).copyTo(local(cv::Rect(1, 1, box.width, box.height)));
-    cv::Mat1f distance;
-    cv::distanceTransform(local, distance, cv::DIST_L2, cv::DIST_MASK_PRECISE);
-    double max_distance = 0.0;
-    cv::minMaxLoc(distance, nullptr, &max_distance);
-    if (max_distance > 0.0) uniformity[i] = cv::mean(distance, local)[0] / max_distance;
-  }
-  return uniformity;
-}
-
 // Per room: how many rooms lose their connection to the largest part of the graph without it (a hub's rooms).
 std::vector<int> roomsBehind(const std::vector<std::set<int>>& neighbours) {
   const int count = static_cast<int>(neighbours.size());
@@ -122,7 +97,6 @@ cv::Mat1f roomFeatures(const SegmentedFloor& floor) {
   const size_t count = floor.rooms.size();
   cv::Mat1f features(static_cast<int>(count), static_cast<int>(roomFeatureNames().size()), 0.0f);
   if (count == 0) return features;
-  const std::vector<double> uniformity = widthUniformity(floor);
   std::vector<int> passages(count, 0);
   std::vector<double> passage_width(count, 0.0);
   std::vector<std::set<int>> neighbours(count);
@@ -167,7 +141,7 @@ cv::Mat1f roomFeatures(const SegmentedFloor& floor) {
         room.area,
         room.width,
         room.width > 0.0 ? room.area / (room.width * room.width) : 0.0,
-        uniformity[i],
+        room.width > 0.0 ? room.mean_width / room.width : 0.0,
         long_side,
         short_side,
         short_side > 0.0 ? long_side / short_side : 0.0,

@@ -26,6 +26,7 @@ struct Room {
   common::Point2 centroid = common::Point2::Zero();  // map frame, metres
   common::Polygon outline;        // outer border of its cells, map frame, metres, counter-clockwise
   double width = 0.0;             // metres: twice the largest distance from a cell to the room's border
+  double mean_width = 0.0;        // metres: twice the mean distance from its cells to its border
   RoomKind kind = RoomKind::kRoom;  // corridor: its type is corridor
   std::string type;               // one of roomTypeNames() (room_types.h); "" when not classified
   bool predicted = false;         // a predicted room behind a closed door (not explored)
