@@ -113,7 +113,8 @@ std::vector<Case> environmentCases(const std::string& folder) {
 // Exploration runs (folders RUNS/NAME of explore_worlds or of the closed-door corpus's store: map.yaml, doors.yaml,
 // exploration.yaml with the fitted world_from_map): each explored map with its closed doors (none when the run's
 // run.yaml says no door was closed: the corpus store's doors.yaml then lists open doors), the spaces of environment
-// NAME (an XML under one of `world_folders`) carried into the map by the fit, on the map's free cells.
+// NAME (an XML under one of `world_folders`) carried into the map by the fit, on the map's free cells (and on those
+// up to 0.15 m off a space: the fit and the raster are off by a cell or two).
 std::vector<Case> exploredCases(const std::string& runs, const std::vector<std::string>& world_folders) {
   std::map<std::string, std::string> worlds;
   for (const std::string& folder : world_folders)
@@ -146,6 +147,24 @@ std::vector<Case> exploredCases(const std::string& runs, const std::vector<std::
         if (world.cellOf(point, &world_col, &world_row))
           each.truth(row, col) = truth.rendered.space_labels(world_row, world_col);
       }
+    // Free cells of the map that land on a wall of the rendering (the fit and the raster are off by a cell or two)
+    // take the space next to them, up to 0.15 m away.
+    const cv::Mat1b free = each.map.cells == common::OccupancyGrid::kFree;
+    for (int step = 0; step < static_cast<int>(std::lround(0.15 / each.map.resolution)); ++step) {
+      cv::Mat1w grown = each.truth.clone();
+      for (int row = 0; row < grown.rows; ++row)
+        for (int col = 0; col < grown.cols; ++col) {
+          if (each.truth(row, col) != 0 || free(row, col) == 0) continue;
+          for (const cv::Point& next : segmentation::kNeighbours8) {
+            const cv::Point cell(col + next.x, row + next.y);
+            if (segmentation::insideImage(grown, cell) && each.truth(cell) != 0) {
+              grown(row, col) = each.truth(cell);
+              break;
+            }
+          }
+        }
+      each.truth = grown;
+    }
     cases.push_back(each);
   }
   if (cases.empty()) throw common::InputError(runs, "holds no exploration run (NAME/exploration.yaml)");
