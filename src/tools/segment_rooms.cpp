@@ -3,6 +3,7 @@
 // map between them.
 #include <chrono>
 #include <filesystem>
+#include <iomanip>
 #include <iostream>
 
 #include "hidden_rooms/common/command_line.h"
@@ -68,7 +69,8 @@ int run(int argc, char** argv) {
   for (const segmentation::Passage& passage : floor.passages) open += passage.kind == segmentation::PassageKind::kOpen;
   std::cout << floor_options.method << ": " << floor.rooms.size() << " rooms (" << corridors << " corridors, "
             << predicted_rooms << " predicted), " << floor.passages.size() << " passages (" << open
-            << " open, " << floor.passages.size() - open << " doors) in " << seconds << " s -> " << out_dir
+            << " open, " << floor.passages.size() - open << " doors) in " << std::fixed << std::setprecision(3)
+            << seconds << " s -> " << out_dir
             << std::endl;
   return common::kExitOk;
 }

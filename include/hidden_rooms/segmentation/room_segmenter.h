@@ -25,9 +25,9 @@ class RoomSegmenter {
   virtual std::string name() const = 0;
   // Every parameter the method reads, with its default (config/segmentation.yaml documents them).
   virtual std::map<std::string, double> defaultParameters() const = 0;
-  // Labels of the input's size: k >= 1 on the cells of room k (labels 1..N, no gaps), 0 on non-free cells and
-  // on free cells the method leaves out (free pockets too small to be a room). `parameters` holds the method's
-  // defaults with the caller's overrides (resolveSegmenterParameters).
+  // Labels of the input's size: one positive number per room on its cells, 0 on free cells the method leaves out
+  // (pockets too small to be a room); non-free cells may hold anything (segmentRooms clears them and numbers the
+  // rooms 1..N). `parameters` holds the method's defaults with the caller's overrides (resolveSegmenterParameters).
   virtual cv::Mat1i segment(const SegmentationInput& input, const std::map<std::string, double>& parameters) const = 0;
 };
 
