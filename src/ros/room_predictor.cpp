@@ -18,6 +18,7 @@
 #include "hidden_rooms/ros/conversions.h"
 #include "hidden_rooms/ros/markers.h"
 #include "hidden_rooms/ros/parameters.h"
+#include "hidden_rooms/segmentation/room_graph.h"
 
 namespace hidden_rooms {
 

@@ -139,17 +139,6 @@ std::vector<Passage> openPassages(const common::OccupancyGrid& map, const cv::Ma
 
 }  // namespace
 
-const char* toString(RoomKind kind) { return kind == RoomKind::kCorridor ? "corridor" : "room"; }
-
-const char* toString(PassageKind kind) {
-  switch (kind) {
-    case PassageKind::kOpen: return "open";
-    case PassageKind::kClosed: return "closed";
-    case PassageKind::kPredicted: return "predicted";
-  }
-  return "open";
-}
-
 SegmentedFloor segmentFloor(const common::OccupancyGrid& map, const common::DoorsFile& doors,
                             const cv::Mat1w& predicted_rooms, const FloorSegmentationOptions& options) {
   if (map.empty()) throw common::InputError("map", "is empty");

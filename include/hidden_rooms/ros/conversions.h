@@ -25,7 +25,7 @@
 #include "hidden_rooms/common/range_scan.h"
 #include "hidden_rooms/mapping/rbpf_mapper.h"
 #include "hidden_rooms/prediction/room_predictor.h"
-#include "hidden_rooms/segmentation/room_graph.h"
+#include "hidden_rooms/segmentation/floor.h"
 #include "hidden_rooms/simulation/simulation.h"
 
 namespace hidden_rooms {

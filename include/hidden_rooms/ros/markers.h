@@ -17,7 +17,7 @@
 #include "hidden_rooms/exploration/frontier.h"
 #include "hidden_rooms/prediction/layout.h"
 #include "hidden_rooms/prediction/room_predictor.h"
-#include "hidden_rooms/segmentation/room_graph.h"
+#include "hidden_rooms/segmentation/floor.h"
 
 namespace hidden_rooms {
 

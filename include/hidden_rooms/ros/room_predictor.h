@@ -22,7 +22,7 @@
 #include "hidden_rooms/common/occupancy_grid.h"
 #include "hidden_rooms/common/options.h"
 #include "hidden_rooms/prediction/room_predictor.h"
-#include "hidden_rooms/segmentation/room_graph.h"
+#include "hidden_rooms/segmentation/floor.h"
 
 namespace hidden_rooms {
 

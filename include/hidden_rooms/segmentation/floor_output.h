@@ -14,7 +14,7 @@
 
 #include "hidden_rooms/common/file_io.h"
 #include "hidden_rooms/common/occupancy_grid.h"
-#include "hidden_rooms/segmentation/room_graph.h"
+#include "hidden_rooms/segmentation/floor.h"
 #include "hidden_rooms/world/environment.h"
 
 namespace hidden_rooms::segmentation {

@@ -10,7 +10,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "hidden_rooms/segmentation/room_graph.h"
+#include "hidden_rooms/segmentation/floor.h"
 
 namespace cv::ml {
 class RTrees;
