@@ -111,4 +111,22 @@ void saveDoors(const DoorsFile& doors, const std::string& path) {
 
 const char* toString(DoorOrientation orientation) { return orientation == DoorOrientation::kAlongX ? "O" : "V"; }
 
+void checkDoorsInsideMap(const OccupancyGrid& map, const DoorsFile& doors) {
+  std::set<int> ids;
+  for (const MapDoor& door : doors.doors) {
+    if (!ids.insert(door.id).second)
+      throw InputError("doors", "door id " + std::to_string(door.id) + " is used twice");
+    int col = 0, row = 0;
+    if (!map.cellOf(door.position, &col, &row)) {
+      throw InputError(
+          "door " + std::to_string(door.id),
+          "position (" + formatNumber(door.position.x()) + ", " + formatNumber(door.position.y()) +
+              ") is outside the map (x " + formatNumber(map.origin.x()) + " .. " +
+              formatNumber(map.origin.x() + map.width() * map.resolution) + ", y " +
+              formatNumber(map.origin.y()) + " .. " +
+              formatNumber(map.origin.y() + map.height() * map.resolution) + " m)");
+    }
+  }
+}
+
 }  // namespace hidden_rooms::common

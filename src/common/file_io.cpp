@@ -5,6 +5,7 @@
 #include <sys/file.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -24,6 +25,24 @@ bool isFile(const std::string& path) {
 bool isFolder(const std::string& path) {
   std::error_code error;
   return std::filesystem::is_directory(path, error);
+}
+
+std::vector<std::string> listFiles(const std::string& folder, const std::string& suffix, bool recursive) {
+  namespace fs = std::filesystem;
+  if (!isFolder(folder)) throw InputError(folder, "is not a folder");
+  std::vector<std::string> files;
+  const auto take = [&](const fs::directory_entry& entry) {
+    const std::string path = entry.path().string();
+    if (entry.is_regular_file() && path.size() > suffix.size() &&
+        path.compare(path.size() - suffix.size(), suffix.size(), suffix) == 0)
+      files.push_back(path);
+  };
+  if (recursive)
+    for (const auto& entry : fs::recursive_directory_iterator(folder)) take(entry);
+  else
+    for (const auto& entry : fs::directory_iterator(folder)) take(entry);
+  std::sort(files.begin(), files.end());
+  return files;
 }
 
 std::string readTextFile(const std::string& path, const std::string& what) {

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <set>
 
 #include <opencv2/imgproc.hpp>
 
@@ -101,24 +100,6 @@ void checkUsableRequest(const PredictionRequest& request) {
   common::checkLimit("doors", "doors x map cells", doors * cells, common::kMaxDoorCells,
                      ": each door's room is a mask of the map's size; predict fewer doors per request");
   checkUsableMap(request.map);
-}
-
-void checkDoorsInsideMap(const common::OccupancyGrid& map, const common::DoorsFile& doors) {
-  std::set<int> ids;
-  for (const common::MapDoor& door : doors.doors) {
-    if (!ids.insert(door.id).second)
-      throw common::InputError("doors", "door id " + std::to_string(door.id) + " is used twice");
-    int col = 0, row = 0;
-    if (!map.cellOf(door.position, &col, &row)) {
-      throw common::InputError(
-          "door " + std::to_string(door.id),
-          "position (" + common::formatNumber(door.position.x()) + ", " + common::formatNumber(door.position.y()) +
-              ") is outside the map (x " + common::formatNumber(map.origin.x()) + " .. " +
-              common::formatNumber(map.origin.x() + map.width() * map.resolution) + ", y " +
-              common::formatNumber(map.origin.y()) + " .. " +
-              common::formatNumber(map.origin.y() + map.height() * map.resolution) + " m)");
-    }
-  }
 }
 
 common::OccupancyGrid insertRooms(const common::OccupancyGrid& map, const common::DoorsFile& doors,

@@ -300,8 +300,7 @@ bool RoomPredictorNode::predictRooms(PredictRooms::Request& request, PredictRoom
   return true;
 }
 
-common::OccupancyGrid RoomPredictorNode::requestMap(const nav_msgs::OccupancyGrid& request_map,
-                                                    std::string* frame) const {
+const nav_msgs::OccupancyGrid& RoomPredictorNode::requestMap(const nav_msgs::OccupancyGrid& request_map) const {
   const bool own_map = request_map.info.width > 0 && request_map.info.height > 0;
   if (!own_map && latest_map_ == nullptr)
     throw common::InputError("map", "the request has no map and none was received on " + map_topic_ + " yet");
@@ -311,8 +310,11 @@ common::OccupancyGrid RoomPredictorNode::requestMap(const nav_msgs::OccupancyGri
     throw common::InputError("map",
                              std::to_string(map_message.info.width) + " x " + std::to_string(map_message.info.height) +
                                  " cells is more than ~max_map_cells (" + std::to_string(options_.max_map_cells) + ")");
-  *frame = map_message.header.frame_id.empty() ? options_.frame_id : map_message.header.frame_id;
-  return common::trinary(fromRos(map_message));  // as map_saver would save it: results equal offline ones
+  return map_message;
+}
+
+std::string RoomPredictorNode::outputFrame(const nav_msgs::OccupancyGrid& map) const {
+  return map.header.frame_id.empty() ? options_.frame_id : map.header.frame_id;
 }
 
 common::DoorsFile RoomPredictorNode::requestDoors(const std::vector<ClosedDoor>& request_doors,
@@ -336,15 +338,14 @@ common::DoorsFile RoomPredictorNode::requestDoors(const std::vector<ClosedDoor>&
 }
 
 void RoomPredictorNode::predict(const PredictRooms::Request& request, PredictRooms::Response* response) {
-  std::string frame;
+  const nav_msgs::OccupancyGrid& map_message = requestMap(request.map);
+  const std::string frame = outputFrame(map_message);
   prediction::PredictionRequest core;
-  core.map = requestMap(request.map, &frame);
-  const nav_msgs::OccupancyGrid& map_message =
-      request.map.info.width > 0 && request.map.info.height > 0 ? request.map : *latest_map_;
+  core.map = common::trinary(fromRos(map_message));  // as map_saver would save it: results equal offline ones
   prediction::checkUsableMap(core.map);
   core.doors = requestDoors(request.doors, frame, true);
   if (core.doors.doors.empty()) throw common::InputError("doors", "no closed doors to predict");
-  prediction::checkDoorsInsideMap(core.map, core.doors);
+  common::checkDoorsInsideMap(core.map, core.doors);
   core.parameters = parameters_;
   for (const auto& [name, value] : fromRos(request.parameters)) core.parameters[name] = value;
   const std::string method = request.method.empty() ? method_ : request.method;
@@ -412,8 +413,9 @@ void RoomPredictorNode::predict(const PredictRooms::Request& request, PredictRoo
 bool RoomPredictorNode::segmentRooms(SegmentRooms::Request& request, SegmentRooms::Response& response) {
   response = SegmentRooms::Response();
   try {
-    std::string frame;
-    const common::OccupancyGrid map = requestMap(request.map, &frame);
+    const nav_msgs::OccupancyGrid& map_message = requestMap(request.map);
+    const std::string frame = outputFrame(map_message);
+    const common::OccupancyGrid map = common::trinary(fromRos(map_message));
     const common::DoorsFile doors = requestDoors(request.doors, frame, false);
     cv::Mat1w predicted;
     if (request.with_predicted_rooms) {

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cctype>
 #include <limits>
+#include <map>
 
 #include <opencv2/imgproc.hpp>
 
@@ -16,7 +17,6 @@ namespace hidden_rooms::segmentation {
 namespace {
 
 std::string spaceId(int label) { return "r" + std::to_string(label); }
-std::string portalId(size_t passage_index) { return "p" + std::to_string(passage_index + 1); }
 
 // The point of `outline`'s edges nearest to `point`.
 common::Point2 nearestOnOutline(const common::Polygon& outline, const common::Point2& point) {
@@ -70,30 +70,31 @@ world::Environment floorToEnvironment(const SegmentedFloor& floor, const common:
     }
     environment.spaces.push_back(space);
   }
+  std::map<std::string, PassageKind> kind_of_portal;
   for (size_t i = 0; i < floor.passages.size(); ++i) {
     const Passage& passage = floor.passages[i];
     if (passage.room_a == 0) continue;  // a door with no room on either side
-    world::Space& first = environment.spaces[passage.room_a - 1];
     world::LineSegment portal;
-    portal.id = portalId(i);
+    portal.id = "p" + std::to_string(i + 1);
     portal.segment_class = world::SegmentClass::kPortal;
     portal.type = passage.kind == PassageKind::kOpen ? "IMPLICIT" : "EXPLICIT";
-    portal.a = portal.b = nearestOnOutline(first.outline, local(passage.centre));
+    portal.a = portal.b = nearestOnOutline(environment.spaces[passage.room_a - 1].outline, local(passage.centre));
+    kind_of_portal[portal.id] = passage.kind;
     world::PortalLink link;
     link.segment_id = portal.id;
-    link.target_ids = {first.id};
-    if (passage.room_b != 0) link.target_ids.push_back(spaceId(passage.room_b));
-    for (const std::string& id : link.target_ids) {
-      world::Space& space = environment.spaces[std::stoi(id.substr(1)) - 1];
+    for (const int label : {passage.room_a, passage.room_b})
+      if (label != 0) link.target_ids.push_back(spaceId(label));
+    for (const int label : {passage.room_a, passage.room_b}) {
+      if (label == 0) continue;
+      world::Space& space = environment.spaces[label - 1];
       space.segments.push_back(portal);
       space.portals.push_back(link);
     }
   }
   world::deriveDoors(&environment, name);
-  for (world::Door& door : environment.doors) {
-    const Passage& passage = floor.passages[std::stoi(door.id.substr(1)) - 1];
-    door.status = passage.kind == PassageKind::kOpen ? world::DoorStatus::kOpen : world::DoorStatus::kClosed;
-  }
+  for (world::Door& door : environment.doors)
+    door.status = kind_of_portal.at(door.id) == PassageKind::kOpen ? world::DoorStatus::kOpen
+                                                                   : world::DoorStatus::kClosed;
   return environment;
 }
 

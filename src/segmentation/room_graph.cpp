@@ -106,12 +106,11 @@ std::vector<Passage> openPassages(const common::OccupancyGrid& map, const cv::Ma
     cv::Rect box;
   };
   std::map<std::pair<int, int>, Border> borders;
-  static const cv::Point kForward[] = {{1, 0}, {-1, 1}, {0, 1}, {1, 1}};
   for (int row = 0; row < labels.rows; ++row)
     for (int col = 0; col < labels.cols; ++col) {
       const int label = labels(row, col);
       if (label == 0 || label > explored_rooms) continue;
-      for (const cv::Point& step : kForward) {
+      for (const cv::Point& step : kForwardNeighbours) {
         const cv::Point next(col + step.x, row + step.y);
         if (next.x < 0 || next.x >= labels.cols || next.y >= labels.rows) continue;
         const int other = labels(next);
@@ -149,14 +148,8 @@ SegmentedFloor segmentFloor(const common::OccupancyGrid& map, const common::Door
   SegmentationInput input;
   input.resolution = map.resolution;
   input.free = common::trinary(map).cells == common::OccupancyGrid::kFree;
-  for (const common::MapDoor& door : doors.doors) {
-    int col = 0, row = 0;
-    if (!map.cellOf(door.position, &col, &row))
-      throw common::InputError("doors", "door " + std::to_string(door.id) + " at (" +
-                                            common::formatNumber(door.position.x()) + ", " +
-                                            common::formatNumber(door.position.y()) + ") lies outside the map");
-    drawDoorLeaf(map, door, &input.free);
-  }
+  common::checkDoorsInsideMap(map, doors);
+  for (const common::MapDoor& door : doors.doors) drawDoorLeaf(map, door, &input.free);
   const std::unique_ptr<RoomSegmenter> method = makeRoomSegmenter(options.method);
 
   SegmentedFloor floor;
@@ -165,17 +158,23 @@ SegmentedFloor segmentFloor(const common::OccupancyGrid& map, const common::Door
   cv::minMaxLoc(floor.labels, nullptr, &explored_max);
   const int explored = static_cast<int>(explored_max);
 
-  // Predicted rooms on the cells the segmentation left unlabelled, numbered after the explored ones.
+  // Predicted rooms on the cells the segmentation left unlabelled, numbered after the explored ones in the order of
+  // their labels.
   int next_label = explored;
   if (!predicted_rooms.empty()) {
-    double predicted_max = 0.0;
-    cv::minMaxLoc(predicted_rooms, nullptr, &predicted_max);
-    for (int k = 1; k <= static_cast<int>(predicted_max); ++k) {
-      const cv::Mat1b cells = (predicted_rooms == k) & (floor.labels == 0);
-      if (cv::countNonZero(cells) == 0) continue;
+    std::vector<int> label_of(65536, 0);  // predicted label -> floor label; -1: on unlabelled cells
+    for (int row = 0; row < map.height(); ++row)
+      for (int col = 0; col < map.width(); ++col)
+        if (predicted_rooms(row, col) != 0 && floor.labels(row, col) == 0) label_of[predicted_rooms(row, col)] = -1;
+    for (int& label : label_of) {
+      if (label == 0) continue;
       if (next_label == 65535) throw common::InputError("predicted rooms", "are too many to label");
-      floor.labels.setTo(++next_label, cells);
+      label = ++next_label;
     }
+    for (int row = 0; row < map.height(); ++row)
+      for (int col = 0; col < map.width(); ++col)
+        if (predicted_rooms(row, col) != 0 && floor.labels(row, col) == 0)
+          floor.labels(row, col) = static_cast<uint16_t>(label_of[predicted_rooms(row, col)]);
   }
   const std::vector<cv::Rect> boxes = labelBoxes(floor.labels, next_label);
   for (int label = 1; label <= next_label; ++label) {

@@ -1,8 +1,7 @@
 #include "hidden_rooms/segmentation/room_segmenter.h"
 
-#include <cmath>
-#include <deque>
 #include <algorithm>
+#include <cmath>
 #include <functional>
 #include <limits>
 #include <set>
@@ -25,6 +24,17 @@ const std::map<std::string, Factory>& registry() {
   return methods;
 }
 
+// Every parameter name some registered method reads.
+const std::set<std::string>& namesReadByAnyMethod() {
+  static const std::set<std::string> names = [] {
+    std::set<std::string> all;
+    for (const auto& [name, factory] : registry())
+      for (const auto& [parameter, value] : factory()->defaultParameters()) all.insert(parameter);
+    return all;
+  }();
+  return names;
+}
+
 }  // namespace
 
 std::vector<std::string> roomSegmenterNames() {
@@ -43,12 +53,9 @@ std::unique_ptr<RoomSegmenter> makeRoomSegmenter(const std::string& name) {
 
 std::map<std::string, double> resolveSegmenterParameters(const RoomSegmenter& method,
                                                          const std::map<std::string, double>& overrides) {
-  std::set<std::string> known;
-  for (const std::string& name : roomSegmenterNames())
-    for (const auto& [parameter, value] : makeRoomSegmenter(name)->defaultParameters()) known.insert(parameter);
   std::map<std::string, double> parameters = method.defaultParameters();
   for (const auto& [name, value] : overrides) {
-    if (!known.count(name)) throw common::InputError("parameters", "no segmentation method reads '" + name + "'");
+    if (!namesReadByAnyMethod().count(name)) throw common::InputError("parameters", "no segmentation method reads '" + name + "'");
     if (!std::isfinite(value))
       throw common::InputError("parameters", "'" + name + "' must be finite, got " + common::formatNumber(value));
     const auto own = parameters.find(name);
@@ -76,21 +83,21 @@ cv::Mat1w segmentRooms(const RoomSegmenter& method, const SegmentationInput& inp
   return rooms;
 }
 
-void spreadLabels(const cv::Mat1b& free, cv::Mat1i* labels) {
-  std::deque<cv::Point> queue;
+void spreadLabels(const cv::Mat1b& free, cv::Mat1i* labels, int max_steps) {
+  std::vector<cv::Point> front;  // the cells labelled in the last step
   for (int row = 0; row < labels->rows; ++row)
     for (int col = 0; col < labels->cols; ++col)
-      if ((*labels)(row, col) != 0) queue.emplace_back(col, row);
-  while (!queue.empty()) {
-    const cv::Point cell = queue.front();
-    queue.pop_front();
-    for (const cv::Point& step : kNeighbours8) {
-      const cv::Point next = cell + step;
-      if (next.x < 0 || next.y < 0 || next.x >= free.cols || next.y >= free.rows) continue;
-      if (free(next) == 0 || (*labels)(next) != 0) continue;
-      (*labels)(next) = (*labels)(cell);
-      queue.push_back(next);
-    }
+      if ((*labels)(row, col) != 0) front.emplace_back(col, row);
+  for (int step = 0; step < max_steps && !front.empty(); ++step) {
+    std::vector<cv::Point> next_front;
+    for (const cv::Point& cell : front)
+      for (const cv::Point& offset : kNeighbours8) {
+        const cv::Point next = cell + offset;
+        if (!insideImage(free, next) || free(next) == 0 || (*labels)(next) != 0) continue;
+        (*labels)(next) = (*labels)(cell);
+        next_front.push_back(next);
+      }
+    front.swap(next_front);
   }
 }
 
@@ -123,9 +130,7 @@ void mergeSmallRooms(const cv::Mat1b& free, const cv::Mat1f& distance, const Roo
       if (label == 0) continue;
       ++area[label];
       peak[label] = std::max(peak[label], static_cast<double>(distance(row, col)));
-      // Forward half of the neighbourhood, so that every pair of cells is counted once.
-      static const cv::Point kForward[] = {{1, 0}, {-1, 1}, {0, 1}, {1, 1}};
-      for (const cv::Point& step : kForward) {
+      for (const cv::Point& step : kForwardNeighbours) {
         const int r = row + step.y, c = col + step.x;
         if (r >= labels->rows || c < 0 || c >= labels->cols || free(r, c) == 0) continue;
         const int other = (*labels)(r, c);

@@ -84,6 +84,10 @@ std::string roomTypeOfLabel(const std::string& label) {
   return found == types.end() ? "" : found->second;
 }
 
+RoomKind roomKindOfLabel(const std::string& label) {
+  return roomTypeOfLabel(label) == "corridor" ? RoomKind::kCorridor : RoomKind::kRoom;
+}
+
 const std::vector<std::string>& roomFeatureNames() {
   static const std::vector<std::string> names = {
       "area",        "width",       "elongation",  "width_uniformity", "long_side",       "short_side",

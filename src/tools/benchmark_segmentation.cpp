@@ -24,6 +24,7 @@
 #include "hidden_rooms/segmentation/floor_output.h"
 #include "hidden_rooms/segmentation/room_graph.h"
 #include "hidden_rooms/segmentation/room_segmenter.h"
+#include "hidden_rooms/segmentation/room_types.h"
 #include "hidden_rooms/segmentation/segmentation_metrics.h"
 #include "hidden_rooms/world/environment.h"
 #include "hidden_rooms/world/render.h"
@@ -45,25 +46,10 @@ struct Case {
 
 constexpr double kSurveyResolution = 0.05;  // metres per pixel of the survey's maps
 
-std::vector<std::string> sortedFiles(const std::string& folder, const std::string& suffix, bool recursive) {
-  if (!common::isFolder(folder)) throw common::InputError(folder, "is not a folder");
-  std::vector<std::string> files;
-  const auto take = [&](const fs::directory_entry& entry) {
-    const std::string path = entry.path().string();
-    if (entry.is_regular_file() && path.size() > suffix.size() &&
-        path.compare(path.size() - suffix.size(), suffix.size(), suffix) == 0)
-      files.push_back(path);
-  };
-  if (recursive) for (const auto& entry : fs::recursive_directory_iterator(folder)) take(entry);
-  else for (const auto& entry : fs::directory_iterator(folder)) take(entry);
-  std::sort(files.begin(), files.end());
-  return files;
-}
-
 std::vector<Case> surveyCases(const std::string& folder) {
   std::vector<Case> cases;
   const std::string suffix = "_gt_segmentation.png";
-  for (const std::string& truth_path : sortedFiles(folder, suffix, false)) {
+  for (const std::string& truth_path : common::listFiles(folder, suffix, false)) {
     const std::string map_path = truth_path.substr(0, truth_path.size() - suffix.size()) + ".png";
     Case each;
     each.name = fs::path(map_path).stem().string();
@@ -90,14 +76,13 @@ SpaceTruth spaceTruth(const std::string& path) {
   const world::Environment environment = world::loadEnvironment(path);
   SpaceTruth truth{world::renderEnvironment(environment, {}), {}};
   for (const world::Space& space : environment.spaces)
-    truth.kinds.push_back(segmentation::toString(space.label == "CORRIDOR" ? segmentation::RoomKind::kCorridor
-                                                                             : segmentation::RoomKind::kRoom));
+    truth.kinds.push_back(segmentation::toString(segmentation::roomKindOfLabel(space.label)));
   return truth;
 }
 
 std::vector<Case> environmentCases(const std::string& folder) {
   std::vector<Case> cases;
-  for (const std::string& path : sortedFiles(folder, ".xml", true)) {
+  for (const std::string& path : common::listFiles(folder, ".xml", true)) {
     SpaceTruth truth = spaceTruth(path);
     Case each;
     each.name = fs::path(path).stem().string();
@@ -118,9 +103,9 @@ std::vector<Case> environmentCases(const std::string& folder) {
 std::vector<Case> exploredCases(const std::string& runs, const std::vector<std::string>& world_folders) {
   std::map<std::string, std::string> worlds;
   for (const std::string& folder : world_folders)
-    for (const std::string& path : sortedFiles(folder, ".xml", true)) worlds[fs::path(path).stem().string()] = path;
+    for (const std::string& path : common::listFiles(folder, ".xml", true)) worlds[fs::path(path).stem().string()] = path;
   std::vector<Case> cases;
-  for (const std::string& fit_path : sortedFiles(runs, "/exploration.yaml", true)) {
+  for (const std::string& fit_path : common::listFiles(runs, "/exploration.yaml", true)) {
     const std::string folder = fs::path(fit_path).parent_path().string();
     const std::string name = fs::path(folder).filename().string();
     if (!worlds.count(name)) throw common::InputError(folder, "names no environment of --worlds");
@@ -136,35 +121,21 @@ std::vector<Case> exploredCases(const std::string& runs, const std::vector<std::
     const bool doors_closed = !common::isFile(folder + "/run.yaml") ||
                               common::loadYamlFile(folder + "/run.yaml", "run summary")["closed"].as<std::string>("") != "";
     if (doors_closed) each.doors = common::loadDoors(folder + "/doors.yaml");
-    each.truth = cv::Mat1w::zeros(each.map.cells.size());
     each.truth_kinds = truth.kinds;
     const common::OccupancyGrid& world = truth.rendered.map;
+    const cv::Mat1b free = each.map.cells == common::OccupancyGrid::kFree;
+    cv::Mat1i spaces(free.size(), 0);
     for (int row = 0; row < each.map.height(); ++row)
       for (int col = 0; col < each.map.width(); ++col) {
-        if (each.map.cells(row, col) != common::OccupancyGrid::kFree) continue;
+        if (free(row, col) == 0) continue;
         const common::Point2 point = common::transformPoint(world_from_map, each.map.cellCentre(col, row));
         int world_col = 0, world_row = 0;
-        if (world.cellOf(point, &world_col, &world_row))
-          each.truth(row, col) = truth.rendered.space_labels(world_row, world_col);
+        if (world.cellOf(point, &world_col, &world_row)) spaces(row, col) = truth.rendered.space_labels(world_row, world_col);
       }
     // Free cells of the map that land on a wall of the rendering (the fit and the raster are off by a cell or two)
     // take the space next to them, up to 0.15 m away.
-    const cv::Mat1b free = each.map.cells == common::OccupancyGrid::kFree;
-    for (int step = 0; step < static_cast<int>(std::lround(0.15 / each.map.resolution)); ++step) {
-      cv::Mat1w grown = each.truth.clone();
-      for (int row = 0; row < grown.rows; ++row)
-        for (int col = 0; col < grown.cols; ++col) {
-          if (each.truth(row, col) != 0 || free(row, col) == 0) continue;
-          for (const cv::Point& next : segmentation::kNeighbours8) {
-            const cv::Point cell(col + next.x, row + next.y);
-            if (segmentation::insideImage(grown, cell) && each.truth(cell) != 0) {
-              grown(row, col) = each.truth(cell);
-              break;
-            }
-          }
-        }
-      each.truth = grown;
-    }
+    segmentation::spreadLabels(free, &spaces, static_cast<int>(std::lround(0.15 / each.map.resolution)));
+    spaces.convertTo(each.truth, CV_16U);
     cases.push_back(each);
   }
   if (cases.empty()) throw common::InputError(runs, "holds no exploration run (NAME/exploration.yaml)");

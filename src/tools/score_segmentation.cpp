@@ -92,7 +92,7 @@ int run(int argc, char** argv) {
     const world::Environment environment = world::loadEnvironment(environment_path);
     std::vector<std::string> truth_kinds, truth_types;
     for (const world::Space& space : environment.spaces) {
-      truth_kinds.push_back(space.label == "CORRIDOR" ? "corridor" : "room");
+      truth_kinds.push_back(segmentation::toString(segmentation::roomKindOfLabel(space.label)));
       truth_types.push_back(segmentation::roomTypeOfLabel(space.label));
     }
     printLabelScores("kinds", segmentation::scoreRoomLabels(found, kinds, truth, truth_kinds));

@@ -1,9 +1,9 @@
 // train_room_types --environments DIR --out MODEL.yml [--folds K]: trains the room type model on the labelled
 // environments of DIR (each rendered with its doors open and segmented; a found room takes the label of the space
 // that overlaps it most), reports its accuracy cross-validated by environment, and writes the model trained on all.
-#include <filesystem>
 #include <iomanip>
 #include <iostream>
+#include <algorithm>
 #include <map>
 
 #include "hidden_rooms/common/command_line.h"
@@ -15,7 +15,6 @@
 #include "hidden_rooms/world/render.h"
 
 namespace po = boost::program_options;
-namespace fs = std::filesystem;
 using namespace hidden_rooms;
 
 namespace {
@@ -61,11 +60,7 @@ int run(int argc, char** argv) {
                                 options, {}, &values))
     return common::kExitOk;
   if (folds < 2) throw common::InputError("--folds", "must be at least 2");
-  std::vector<std::string> paths;
-  if (!common::isFolder(environments_dir)) throw common::InputError(environments_dir, "is not a folder");
-  for (const auto& entry : fs::recursive_directory_iterator(environments_dir))
-    if (entry.is_regular_file() && entry.path().extension() == ".xml") paths.push_back(entry.path().string());
-  std::sort(paths.begin(), paths.end());
+  const std::vector<std::string> paths = common::listFiles(environments_dir, ".xml", true);
   if (static_cast<int>(paths.size()) < folds) throw common::InputError(environments_dir, "has fewer environments than folds");
 
   segmentation::FloorSegmentationOptions floor_options;

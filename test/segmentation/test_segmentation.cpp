@@ -274,7 +274,7 @@ TEST(RoomSegmentation, BadInputGivesClearErrors) {
   FloorWithDoors input;
   input.doors.doors.push_back({9, {100.0, 3.0}, 0.9, common::DoorOrientation::kAlongX, std::nullopt});
   EXPECT_NE(testing::inputErrorMessage([&] { segmentFloor(input.drawn.map, input.doors, {}, {}); })
-                .find("door 9 at (100, 3) lies outside the map"),
+                .find("door 9: position (100, 3) is outside the map"),
             std::string::npos);
   EXPECT_NE(testing::inputErrorMessage([&] { segmentFloor(input.drawn.map, {}, cv::Mat1w::zeros(3, 3), {}); })
                 .find("predicted rooms"),

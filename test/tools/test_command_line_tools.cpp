@@ -338,7 +338,7 @@ TEST(SegmentRoomsTool, BadInputGivesAClearErrorAndWritesNothing) {
   std::ofstream(dir + "/far_doors.yaml") << "doors:\n- {id: 3, position: [90.0, 4.0], width: 0.9, orientation: O}\n";
   std::ofstream(dir + "/typo.yaml") << "pasage_ratio: 0.5\n";
   const std::string base = kSegment + " " + input + "/map.yaml --out " + dir + "/out";
-  expectBadInput(base + " --doors " + dir + "/far_doors.yaml", "door 3 at (90, 4) lies outside the map");
+  expectBadInput(base + " --doors " + dir + "/far_doors.yaml", "door 3: position (90, 4) is outside the map");
   expectBadInput(base + " --method watershed", "unknown segmentation method 'watershed'");
   expectBadInput(base + " --params " + dir + "/typo.yaml", "no segmentation method reads 'pasage_ratio'");
   expectBadInput(base + " --rooms " + dir + "/absent.yaml", "absent.yaml");

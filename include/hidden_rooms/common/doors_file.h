@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "hidden_rooms/common/geometry.h"
+#include "hidden_rooms/common/occupancy_grid.h"
 
 namespace hidden_rooms::common {
 
@@ -39,5 +40,10 @@ struct DoorsFile {
 DoorsFile loadDoors(const std::string& path);
 DoorsFile parseDoors(const std::string& yaml_text, const std::string& source_name);
 void saveDoors(const DoorsFile& doors, const std::string& path);
+
+// For doors from outside (a service request, a doors file beside a map): throws InputError("door ID", ...) naming
+// the first door whose position lies outside the map's extent (usually a door given in another frame), and
+// InputError("doors", ...) when two doors share an id.
+void checkDoorsInsideMap(const OccupancyGrid& map, const DoorsFile& doors);
 
 }  // namespace hidden_rooms::common

@@ -16,6 +16,9 @@ namespace hidden_rooms::common {
 // component that is a file, no permission), where std::filesystem's one-argument forms throw.
 bool isFile(const std::string& path);
 bool isFolder(const std::string& path);
+// The regular files in `folder` (and its subfolders when `recursive`) whose paths end with `suffix`, sorted.
+// Throws InputError when `folder` is not a folder.
+std::vector<std::string> listFiles(const std::string& folder, const std::string& suffix, bool recursive);
 
 std::string readTextFile(const std::string& path, const std::string& what);
 YAML::Node loadYamlFile(const std::string& path, const std::string& what);

@@ -39,11 +39,6 @@ void checkUsableMap(const common::OccupancyGrid& map);
 // of common/input_limits.h. Throws InputError naming the limit.
 void checkUsableRequest(const PredictionRequest& request);
 
-// For requests from outside (the predict_rooms service): throws InputError("door ID", ...) naming the first
-// door whose position lies outside the map's extent (usually a door given in another frame), and
-// InputError("doors", ...) when two doors share an id.
-void checkDoorsInsideMap(const common::OccupancyGrid& map, const common::DoorsFile& doors);
-
 // The input map completed with the predicted rooms (docs/method.md#completed-map): each placed room's cells free,
 // unknown cells around it walled, and its door opened as a free rectangle of the door's width joining the room to the
 // explored side.

@@ -93,9 +93,11 @@ class RoomPredictorNode {
   void predictAndLog(const std::string& why);
   // Predicts and publishes; throws InputError for an unusable request.
   void predict(const PredictRooms::Request& request, PredictRooms::Response* response);
-  // The request's map, or the latest one (checked against ~max_map_cells), as map_saver would save it; throws
-  // InputError when there is none or it is too large. `frame`: its frame.
-  common::OccupancyGrid requestMap(const nav_msgs::OccupancyGrid& request_map, std::string* frame) const;
+  // The request's map, or the latest one; throws InputError when there is none or it has more cells than
+  // ~max_map_cells.
+  const nav_msgs::OccupancyGrid& requestMap(const nav_msgs::OccupancyGrid& request_map) const;
+  // The frame of the outputs on `map`: its header's, else ~frame_id.
+  std::string outputFrame(const nav_msgs::OccupancyGrid& map) const;
   // The request's doors, else the node's; throws InputError when neither has any and `required`.
   common::DoorsFile requestDoors(const std::vector<ClosedDoor>& request_doors, const std::string& frame,
                                  bool required) const;

@@ -3,6 +3,7 @@
 // Room segmentation of an occupancy grid: every free cell gets a room label. One interface for the package's
 // method and the survey's baselines (Bormann et al., ICRA 2016), chosen by name (`makeRoomSegmenter`).
 
+#include <limits>
 #include <map>
 #include <memory>
 #include <string>
@@ -49,15 +50,18 @@ cv::Mat1w segmentRooms(const RoomSegmenter& method, const SegmentationInput& inp
 
 // --- Building blocks shared by the methods ---
 
-// The eight neighbours of a cell, row by row.
+// The eight neighbours of a cell, row by row; the forward half of them (right and the row below), so that a scan
+// over all cells visits every pair of neighbouring cells once.
 inline const cv::Point kNeighbours8[] = {{-1, -1}, {0, -1}, {1, -1}, {-1, 0}, {1, 0}, {-1, 1}, {0, 1}, {1, 1}};
+inline const cv::Point kForwardNeighbours[] = {{1, 0}, {-1, 1}, {0, 1}, {1, 1}};
 inline bool insideImage(const cv::Mat& image, const cv::Point& cell) {
   return cell.x >= 0 && cell.y >= 0 && cell.x < image.cols && cell.y < image.rows;
 }
 
 // Grows the labelled cells of `labels` into the unlabelled free cells (8-connected breadth-first, each cell taking
-// the label that reaches it first: borders fall halfway between the seeds). Free cells no label reaches stay 0.
-void spreadLabels(const cv::Mat1b& free, cv::Mat1i* labels);
+// the label that reaches it first: borders fall halfway between the seeds), at most `max_steps` cells far. Free
+// cells no label reaches stay 0.
+void spreadLabels(const cv::Mat1b& free, cv::Mat1i* labels, int max_steps = std::numeric_limits<int>::max());
 
 // What a room needs to be one (cells).
 struct RoomLimits {

@@ -23,6 +23,8 @@ const std::vector<std::string>& roomTypeNames();
 // The type of a space labelled `label` in an environment XML (CORRIDOR, OFFICE, CLASSROOM, ...); "" for a label
 // of no type.
 std::string roomTypeOfLabel(const std::string& label);
+// The kind of a space labelled `label`: a corridor when its type is.
+RoomKind roomKindOfLabel(const std::string& label);
 
 // One row per room of `floor` (its label order), the columns of roomFeatureNames().
 cv::Mat1f roomFeatures(const SegmentedFloor& floor);
