@@ -110,6 +110,19 @@ struct RbpfMapper::Impl {
   std::string config_file;
   int added = 0;
   int inserted = 0;
+  // With the front-end's loop closure: each entry of the particles' paths with the front-end pose it was fed,
+  // anchored to the front-end's keyframe, so that the paths follow when an optimization moves the keyframes.
+  struct PathAnchor {
+    size_t path_index;
+    KeyframeAnchor anchor;
+    common::Pose2 fed;
+  };
+  std::vector<PathAnchor> path_anchors;
+  KeyframeAnchor last_odometry_anchor;
+  // The pose after every scan, anchored to the front-end's newest keyframe then (with loop closure).
+  std::vector<KeyframeAnchor> scan_poses;
+  int loop_closures_applied = 0;
+  void followOptimizedKeyframes();
 
   // The published map: every inserted scan drawn again along the path of the particle whose grid MRPT calls the
   // most likely one, with the [PublishedMap] certainties (as gmapping renders its map from the best particle's
@@ -206,6 +219,7 @@ bool RbpfMapper::addScan(const common::Pose2& odometry, const mrpt::obs::CObserv
   Impl& impl = *impl_;
   impl.last_raw_odometry = odometry;
   const common::Pose2 filter_odometry = impl.front_end ? impl.front_end->correct(odometry, scan) : odometry;
+  if (impl.front_end && impl.front_end->loopClosures() != impl.loop_closures_applied) impl.followOptimizedKeyframes();
   if (!impl.started) {
     mrpt::poses::CPosePDFGaussian start(toMrpt(filter_odometry));
     impl.builder->initialize(mrpt::maps::CSimpleMap(), &start);
@@ -223,12 +237,21 @@ bool RbpfMapper::addScan(const common::Pose2& odometry, const mrpt::obs::CObserv
   actions.insert(movement);
   impl.last_odometry = filter_odometry;
 
+  const size_t path_length = impl.builder->mapPDF.m_particles.front().d->robotPath.size();
   try {
     impl.builder->processActionObservation(actions, frame);
   } catch (const std::exception& error) {  // options that do not fit together (an ICP method for another map type)
     throw common::InputError(impl.config_file, "MRPT rejects these options while mapping: " + mrptMessage(error));
   }
+  if (impl.front_end) {
+    impl.last_odometry_anchor = impl.front_end->anchor(filter_odometry);
+    const size_t length = impl.builder->mapPDF.m_particles.front().d->robotPath.size();
+    for (size_t index = path_length; index < length; ++index)
+      impl.path_anchors.push_back({index, impl.last_odometry_anchor, filter_odometry});
+  }
   ++impl.added;
+  const common::Pose2 now = pose();
+  impl.scan_poses.push_back(impl.front_end ? impl.front_end->anchor(now) : KeyframeAnchor{KeyframeAnchor::kNone, now});
   const bool was_inserted = impl.builder->m_statsLastIteration.observationsInserted;
   impl.inserted += was_inserted;
   if (was_inserted) {
@@ -236,6 +259,33 @@ bool RbpfMapper::addScan(const common::Pose2& odometry, const mrpt::obs::CObserv
     impl.inserted_path_index.push_back(impl.builder->mapPDF.m_particles.front().d->robotPath.size() - 1);
   }
   return was_inserted;
+}
+
+// The front-end's optimization moved its keyframes: every path entry moves as its keyframe did (the particles'
+// own offsets from the front-end's poses kept), and so does the odometry the next increment is taken from.
+void RbpfMapper::Impl::followOptimizedKeyframes() {
+  for (PathAnchor& entry : path_anchors) {
+    const common::Pose2 now = front_end->resolve(entry.anchor);
+    const common::Pose2 moved = common::composePoses(now, common::invertPose(entry.fed));
+    entry.fed = now;
+    for (auto& particle : builder->mapPDF.m_particles) {
+      mrpt::math::TPose3D& pose = particle.d->robotPath[entry.path_index];
+      const common::Pose2 corrected = common::composePoses(moved, fromMrpt(pose));
+      pose.x = corrected.x;
+      pose.y = corrected.y;
+      pose.yaw = corrected.yaw;
+    }
+  }
+  last_odometry = front_end->resolve(last_odometry_anchor);
+  loop_closures_applied = front_end->loopClosures();
+}
+
+std::vector<common::Pose2> RbpfMapper::trajectory() const {
+  std::vector<common::Pose2> poses;
+  poses.reserve(impl_->scan_poses.size());
+  for (const KeyframeAnchor& anchor : impl_->scan_poses)
+    poses.push_back(impl_->front_end ? impl_->front_end->resolve(anchor) : anchor.offset);
+  return poses;
 }
 
 int RbpfMapper::scansAdded() const { return impl_->added; }

@@ -91,7 +91,9 @@ int run(int argc, char** argv) {
       ("comparison", po::value(&comparison_path),
        "when scoring: PNG of the map on the truth (white: both free; orange / red / magenta: observed free the "
        "map has unknown / uncertain / occupied; blue: map free where the truth is not observed free)")
-      ("trajectory", po::value(&trajectory_path), "also write the SLAM pose at every scan as a pose log (map frame)")
+      ("trajectory", po::value(&trajectory_path),
+       "also write the SLAM pose at every scan as a pose log (map frame), as estimated at the end (loop closures "
+       "move earlier poses)")
       ("quiet", po::bool_switch(&quiet), "no progress line");
   po::positional_options_description positional;
   positional.add("bag", 1);
@@ -280,6 +282,9 @@ int run(int argc, char** argv) {
   }
 
   const hidden_rooms::common::OccupancyGrid map = mapper.map();
+  // The poses as the mapper estimates them at the end (a loop closure moves the poses before it).
+  const std::vector<Pose2> final_poses = mapper.trajectory();
+  for (size_t i = 0; i < estimated.size() && i < final_poses.size(); ++i) estimated[i].pose = final_poses[i];
   const std::string yaml = hidden_rooms::common::saveMap(map, prefix);
   std::printf("bag: %s\nmap: %s\nscans: %d\nscans_inserted: %d\nscans_dropped: %d\nbag_seconds: %.2f\n"
               "wall_seconds: %.2f\nspeed_factor: %.1f\n",

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "hidden_rooms/common/input_error.h"
+#include "hidden_rooms/evaluation/door_translation.h"
 #include "hidden_rooms/evaluation/map_quality.h"
 #include "hidden_rooms/mapping/rbpf_mapper.h"
 #include "hidden_rooms/simulation/simulation.h"
@@ -53,6 +54,8 @@ struct MappingRun {
   int scans = 0;
   int inserted = 0;
   std::vector<RbpfParticle> particles;
+  std::vector<common::Pose2> online_poses;  // pose() after each scan
+  std::vector<common::Pose2> final_poses;   // trajectory() at the end
 };
 
 // Drives the robot (wander) through a world for `seconds` and maps it with scans at 10 Hz, with the mapper's
@@ -94,13 +97,33 @@ MappingRun mapWorld(const std::string& world_file, double seconds, uint32_t mapp
     true_poses.push_back(simulation.truePose());
     ++run.scans;
   }
-  const common::Pose2 world_from_map = common::composePoses(simulation.truePose(), common::invertPose(mapper.pose()));
+  // Scored as map_from_bag scores: the map placed in the world by the rigid fit of the whole trajectory as the
+  // mapper estimates it at the end (loop closures move earlier poses).
+  const std::vector<common::Pose2> final_poses = mapper.trajectory();
+  std::vector<common::TimedPose> timed_truth, timed_estimate;
+  for (size_t i = 0; i < final_poses.size(); ++i) {
+    timed_truth.push_back({static_cast<double>(i), true_poses[i]});
+    timed_estimate.push_back({static_cast<double>(i), final_poses[i]});
+  }
+  const common::Pose2 world_from_map = evaluation::fitWorldFromMap(timed_truth, timed_estimate);
   run.map = mapper.map();
   run.quality = evaluation::evaluateMap(run.map, world_from_map, truth.map, observed);
-  run.trajectory = evaluation::trajectoryError(estimate, true_poses, world_from_map);
+  run.trajectory = evaluation::trajectoryError(final_poses, true_poses, world_from_map);
   run.inserted = mapper.scansInserted();
   run.particles = mapper.particles();
+  run.online_poses = estimate;
+  run.final_poses = final_poses;
   return run;
+}
+
+// Without loop closure no pose moves once estimated: trajectory() is pose() after each scan.
+void expectTrajectoryIsTheOnlinePoses(const MappingRun& run) {
+  ASSERT_EQ(run.final_poses.size(), static_cast<size_t>(run.scans));
+  for (size_t i = 0; i < run.final_poses.size(); ++i) {
+    EXPECT_NEAR(run.final_poses[i].x, run.online_poses[i].x, 1e-9) << "scan " << i;
+    EXPECT_NEAR(run.final_poses[i].y, run.online_poses[i].y, 1e-9) << "scan " << i;
+    EXPECT_NEAR(run.final_poses[i].yaw, run.online_poses[i].yaw, 1e-9) << "scan " << i;
+  }
 }
 
 TEST(RbpfMapper, MapsASmallWorldCloseToTheGroundTruth) {
@@ -119,6 +142,7 @@ TEST(RbpfMapper, MapsASmallWorldCloseToTheGroundTruth) {
   EXPECT_EQ(run.particles.size(), 8u);
   EXPECT_NEAR(weights, 1.0, 1e-9);
   EXPECT_NEAR(run.map.resolution, 0.05, 1e-6);
+  expectTrajectoryIsTheOnlinePoses(run);
 }
 
 TEST(RbpfMapper, SameScansAndSeedGiveTheSameMap) {
@@ -161,8 +185,10 @@ TEST(RbpfMapper, StartsAtTheFirstOdometryPose) {
   EXPECT_THROW(mapper.addScan({0.0, 0.0, 0.0}, common::RangeScan()), common::InputError);
 }
 
-// The real-laser configuration: its scan-matching front-end takes out most of a drifting odometry's error, which
-// the same ini without the front-end (one particle following the odometry) keeps.
+// The real-laser configuration: its scan-matching front-end (and its loop closure, as the wander comes back to
+// places it left 20 m before) takes out most of a drifting odometry's error, which the same ini without the
+// front-end (one particle following the odometry) keeps. What loop closure is worth shows on the real logs
+// (test/python/test_carmen.py).
 TEST(RbpfMapper, TheScanMatchingFrontEndCorrectsDriftingOdometry) {
   const std::string world = std::string(HIDDEN_ROOMS_SOURCE_DIR) + "/worlds/small_1.xml";
   std::ifstream in(kRealLaserConfig);
@@ -181,6 +207,14 @@ TEST(RbpfMapper, TheScanMatchingFrontEndCorrectsDriftingOdometry) {
   EXPECT_LT(with_front_end.trajectory.position_rmse, 0.5 * odometry_only.trajectory.position_rmse);
   EXPECT_GT(with_front_end.quality.walls_within_2_cells, odometry_only.quality.walls_within_2_cells + 0.1);
   EXPECT_GE(with_front_end.quality.free_iou, 0.8);
+  // The loops closed moved poses estimated before them.
+  ASSERT_EQ(with_front_end.final_poses.size(), static_cast<size_t>(with_front_end.scans));
+  double moved = 0.0;
+  for (size_t i = 0; i < with_front_end.final_poses.size(); ++i)
+    moved = std::max(moved, std::hypot(with_front_end.final_poses[i].x - with_front_end.online_poses[i].x,
+                                       with_front_end.final_poses[i].y - with_front_end.online_poses[i].y));
+  EXPECT_GT(moved, 0.001);
+  expectTrajectoryIsTheOnlinePoses(odometry_only);
 }
 
 TEST(RbpfMapper, RejectsBadIniFiles) {
@@ -229,8 +263,18 @@ TEST(RbpfMapper, RejectsBadIniFiles) {
     RbpfMapper mapper(options);
     ADD_FAILURE() << "min_goodness 2 accepted";
   } catch (const common::InputError& error) {
-    EXPECT_NE(std::string(error.what()).find("[ScanMatching] min_goodness must be in [0, 1]"), std::string::npos)
+    EXPECT_NE(std::string(error.what()).find("[ScanMatching] min_goodness and loop_min_goodness must be in [0, 1]"),
+              std::string::npos)
         << error.what();
+  }
+  // Loop closure with an empty search window.
+  std::ofstream(options.config_file) << text
+                                     << "\n[ScanMatching]\nenabled = 1\nloop_min_travel = 20\nloop_search_radius = 0\n";
+  try {
+    RbpfMapper mapper(options);
+    ADD_FAILURE() << "loop_search_radius 0 accepted";
+  } catch (const common::InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("loop_search_radius"), std::string::npos) << error.what();
   }
 }
 

@@ -1,8 +1,8 @@
 #!/usr/bin/python3
 """carmen_to_bag: a CARMEN log read (FLASER lines), turned into the bag a ROS robot records (scans, odometry tf, the
 laser mount, the true poses) and into a reference map; the odometry drift model; bad logs refused with one line.
-With the shared data beside the checkout, both real logs are converted and mapped by map_from_bag, scored against
-their reference maps (the figures are printed; the accuracy targets of the real-data issue are not floors yet)."""
+With the shared data beside the checkout, both real logs are converted with drifting odometry, mapped by
+map_from_bag with config/rbpf_real_laser.ini and scored against their reference maps, with accuracy floors."""
 import math
 import os
 import subprocess
@@ -111,6 +111,12 @@ class CarmenLogTest(unittest.TestCase):
             self.assertFalse(os.path.exists(out))
 
 
+# Floors of free IoU and walls within 2 cells on the drifted bags with config/rbpf_real_laser.ini. Intel: the
+# targets of the real-data issue (0.85, 0.90); measured 0.908 / 0.954. ACES: measured 0.827 / 0.862, where the
+# same ini without loop closure (loop_min_travel = 0) maps 0.768 / 0.491.
+REAL_LOG_FLOORS = {"intel": (0.85, 0.90), "aces": (0.78, 0.75)}
+
+
 class RealLogsTest(unittest.TestCase):
     """Both real logs through carmen_to_bag and map_from_bag --reference-map (the real-data smoke test)."""
 
@@ -128,7 +134,8 @@ class RealLogsTest(unittest.TestCase):
                             "--odometry-noise", "0.05,2,0.01,0.5"], check=True, capture_output=True)
             trajectory = os.path.join(folder, name + "_trajectory.log")
             result = subprocess.run([map_from_bag, bag, "--out", os.path.join(folder, name), "--quiet",
-                                     "--reference-map", reference + ".yaml", "--trajectory", trajectory],
+                                     "--reference-map", reference + ".yaml", "--trajectory", trajectory,
+                                     "--config", os.path.join(PACKAGE_DIR, "config", "rbpf_real_laser.ini")],
                                     capture_output=True, text=True)
             self.assertEqual(result.returncode, 0, result.stderr)
             figures = dict(line.split(": ", 1) for line in result.stdout.splitlines() if ": " in line)
@@ -138,8 +145,8 @@ class RealLogsTest(unittest.TestCase):
             with open(trajectory) as stream:
                 poses = [line for line in stream if not line.startswith("#")]
             self.assertEqual(len(poses), int(figures["scans"]), "one SLAM pose per scan")
-            for key in ("free_iou", "walls_within_2_cells"):
-                self.assertTrue(0.0 < float(figures[key]) <= 1.0, key)
+            for key, floor in zip(("free_iou", "walls_within_2_cells"), REAL_LOG_FLOORS[name]):
+                self.assertGreaterEqual(float(figures[key]), floor, "%s %s" % (name, key))
 
 
 if __name__ == "__main__":

@@ -60,6 +60,9 @@ class RbpfMapper {
   // The pose estimate of base_link in the map frame: the pose (with the odometry since the filter's last update)
   // of the particle whose grid map() returns, so that pose and map agree; the first odometry pose before any scan.
   common::Pose2 pose() const;
+  // pose() after each scan added so far, as the mapper estimates them now: a loop closure of the scan-matching
+  // front-end moves earlier poses with the keyframes they were anchored to.
+  std::vector<common::Pose2> trajectory() const;
   // map -> odom (REP-105): the transform that puts the last odometry pose at pose().
   common::Pose2 mapToOdom() const;
   std::vector<RbpfParticle> particles() const;
