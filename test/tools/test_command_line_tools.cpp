@@ -31,6 +31,7 @@ const std::string kSlice = SLICE_OCTOMAP_BIN;
 const std::string kSegment = SEGMENT_ROOMS_BIN;
 const std::string kScoreSegmentation = SCORE_SEGMENTATION_BIN;
 const std::string kTrainRoomTypes = TRAIN_ROOM_TYPES_BIN;
+const std::string kHideRooms = HIDE_ROOMS_BIN;
 
 std::string writeSynthetic(const std::string& dir, const std::string& xml) {
   const std::string path = dir + "/world.xml";
@@ -350,6 +351,32 @@ TEST(SegmentRoomsTool, BadInputGivesAClearErrorAndWritesNothing) {
   EXPECT_FALSE(std::filesystem::exists(dir + "/out"));
 }
 
+// A complete map (here a rendering, every door open) made into a closed-door case and predicted on.
+TEST(HideRoomsTool, MakesAClosedDoorCaseOfACompleteMapThatPredictionsScoreOn) {
+  const std::string dir = testing::makeTempDir("hide_rooms_tool");
+  const std::string world = writeSynthetic(dir, testing::corridorWithTwoRoomsXml());
+  ASSERT_EQ(runCommand(kRender + " " + world + " --out " + dir + "/rendered").exit_code, 0);
+  const auto result = runCommand(kHideRooms + " " + dir + "/rendered/map.yaml --out " + dir + "/case");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_NE(result.output.find("2 of 3 rooms hidden"), std::string::npos) << result.output;
+  EXPECT_EQ(testing::fileNames(dir + "/case"),
+            (std::vector<std::string>{"doors.yaml", "gt_rooms.png", "map.pgm", "map.yaml"}));
+  EXPECT_EQ(common::loadDoors(dir + "/case/doors.yaml").doors.size(), 2u);
+  const auto predicted = runCommand(kPredict + " --map " + dir + "/case/map.yaml --doors " + dir +
+                                    "/case/doors.yaml --method default --out " + dir + "/prediction --gt-rooms " +
+                                    dir + "/case/gt_rooms.png");
+  ASSERT_EQ(predicted.exit_code, 0) << predicted.output;
+  const YAML::Node metrics = YAML::LoadFile(dir + "/prediction/metrics.yaml");
+  std::printf("mean IoU on the case: %.3f\n", metrics["mean_iou"].as<double>());
+  EXPECT_GT(metrics["mean_iou"].as<double>(), 0.6);
+
+  const std::string base = kHideRooms + " " + dir + "/rendered/map.yaml --out " + dir + "/bad";
+  expectBadInput(base + " --max-rooms -1", "--max-rooms: must be 0 or more");
+  expectBadInput(base + " --max-door-width 0.3", "has no closable room");
+  expectBadInput(kHideRooms + " " + dir + "/absent.yaml --out " + dir + "/bad", "absent.yaml: cannot open map yaml");
+  EXPECT_FALSE(std::filesystem::exists(dir + "/bad"));
+}
+
 // Oversized inputs, each tool run with its address space limited to 2 GB: exit 2 and a message naming the limit
 // (before, an image declaring 1e10 pixels aborted the map readers, --height 100 took 23 GB, 5000 doors 4.8 GB).
 TEST(Tools, OversizedInputsAreRefusedWithinTwoGigabytes) {
@@ -451,6 +478,7 @@ TEST(Tools, RandomCorruptionsOfGoodInputsExitZeroOrTwoWithOneLineAndNoPartialOut
   ASSERT_EQ(runCommand(kExport + " " + input + "/map.yaml --out " + dir + "/tree.bt").exit_code, 0);
   const std::string world = dir + "/world.xml";
   std::ofstream(world) << testing::corridorWithTwoRoomsXml();
+  ASSERT_EQ(runCommand(kRender + " " + world + " --out " + dir + "/rendered").exit_code, 0);  // every door open
   std::ofstream(dir + "/params.yaml") << "start_search_radius: 1.5\nwall_margin: 2\n";
 
   struct Target {
@@ -485,6 +513,13 @@ TEST(Tools, RandomCorruptionsOfGoodInputsExitZeroOrTwoWithOneLineAndNoPartialOut
        [&](const std::string& f) { return kSlice + " " + f + " --out " + out + "/map.yaml"; }, out},
       {"render world.xml", world,
        [&](const std::string& f) { return kRender + " " + f + " --closed all --hide-closed-rooms --out " + out; }, out},
+      {"hide_rooms map.pgm", dir + "/rendered/map.pgm",
+       [&](const std::string& f) {
+         std::ofstream(dir + "/c/rendered.yaml") << "image: " + f + "\nresolution: 0.05\norigin: [0, 0, 0]\n"
+                                                    "negate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n";
+         return kHideRooms + " " + dir + "/c/rendered.yaml --out " + out;
+       },
+       out},
   };
 #ifdef __SANITIZE_ADDRESS__
   const std::string limited;  // AddressSanitizer reserves terabytes of address space for its shadow memory
@@ -525,6 +560,7 @@ TEST(Tools, HelpExitsZero) {
   EXPECT_EQ(runCommand(kPredict + " --help").exit_code, 0);
   EXPECT_EQ(runCommand(kSegment + " --help").exit_code, 0);
   EXPECT_EQ(runCommand(kScoreSegmentation + " --help").exit_code, 0);
+  EXPECT_EQ(runCommand(kHideRooms + " --help").exit_code, 0);
 }
 
 }  // namespace
