@@ -98,16 +98,7 @@ world::HiddenRoomsCase hideRooms(const common::OccupancyGrid& map, const segment
     hidden.closed_doors.doors.push_back(
         doorway(map, floor.labels, label, other, static_cast<int>(k + 1), &borders.back()));
   }
-  // Known cells nearer to a hidden room than to the free space left in view, and out of wall_reach of that free
-  // space, are unseen with the room (its far walls and what the map left uncertain inside it).
-  const cv::Mat1b visible_free = free & ~hidden_cells;
-  const cv::Mat1b hidden_free = free & hidden_cells;
-  cv::Mat1f to_visible, to_hidden;
-  cv::distanceTransform(~visible_free, to_visible, cv::DIST_L2, cv::DIST_MASK_PRECISE);
-  cv::distanceTransform(~hidden_free, to_hidden, cv::DIST_L2, cv::DIST_MASK_PRECISE);
-  const float reach = static_cast<float>(options.wall_reach / map.resolution);
-  hidden.map.cells.setTo(common::OccupancyGrid::kUnknown, hidden_cells);
-  hidden.map.cells.setTo(common::OccupancyGrid::kUnknown, (to_hidden < to_visible) & (to_visible > reach));
+  world::hideUnseenRooms(hidden_cells, options.wall_reach / map.resolution, &hidden.map);
   // The closed doors: a wall along each doorway's border cells, where the room met the rest of the floor.
   for (const std::vector<cv::Point>& border : borders)
     for (const cv::Point& cell : border) hidden.map.cells(cell) = common::OccupancyGrid::kOccupied;

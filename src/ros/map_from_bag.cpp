@@ -170,7 +170,7 @@ int run(int argc, char** argv) {
   tf2::BufferCore tf_buffer(ros::Duration(std::max(60.0, bag_seconds + 10.0)));
   std::deque<sensor_msgs::LaserScan::ConstPtr> pending;
   std::vector<TimedPose> true_poses;
-  std::vector<TimedPose> estimated;  // the SLAM pose at every scan's stamp
+  std::vector<double> scan_stamps;  // of the scans the mapper took, in order (the poses: mapper.trajectory())
   std::vector<std::pair<double, hidden_rooms::common::RangeScan>> inserted_scans;  // for the observed cells
   int processed = 0, dropped = 0, received = 0, without_returns = 0, without_mount = 0;
   std::string last_tf_error, last_mount_error;
@@ -212,7 +212,7 @@ int run(int argc, char** argv) {
     const bool inserted = mapper.addScan(odometry, observation);
     ++processed;
     if (scoring || !trajectory_path.empty()) {
-      estimated.push_back({scan.header.stamp.toSec(), mapper.pose()});
+      scan_stamps.push_back(scan.header.stamp.toSec());
       if (inserted) inserted_scans.emplace_back(scan.header.stamp.toSec(), hidden_rooms::fromRos(upright, mount.pose));
     }
   };
@@ -282,9 +282,12 @@ int run(int argc, char** argv) {
   }
 
   const hidden_rooms::common::OccupancyGrid map = mapper.map();
-  // The poses as the mapper estimates them at the end (a loop closure moves the poses before it).
+  // The SLAM pose at every scan's stamp, as the mapper estimates it at the end (a loop closure moves the poses
+  // before it).
+  std::vector<TimedPose> estimated;
   const std::vector<Pose2> final_poses = mapper.trajectory();
-  for (size_t i = 0; i < estimated.size() && i < final_poses.size(); ++i) estimated[i].pose = final_poses[i];
+  for (size_t i = 0; i < scan_stamps.size() && i < final_poses.size(); ++i)
+    estimated.push_back({scan_stamps[i], final_poses[i]});
   const std::string yaml = hidden_rooms::common::saveMap(map, prefix);
   std::printf("bag: %s\nmap: %s\nscans: %d\nscans_inserted: %d\nscans_dropped: %d\nbag_seconds: %.2f\n"
               "wall_seconds: %.2f\nspeed_factor: %.1f\n",

@@ -216,18 +216,19 @@ HiddenRoomsCase hideClosedRooms(const Environment& environment, const RenderedEn
     hidden.true_rooms.setTo(static_cast<uint16_t>(k + 1), cells);
     hidden_free |= cells;
   }
-  // Walls within reach of a hidden room and out of reach of every explored free cell are unseen too.
-  const cv::Mat1b visible_free = (rendered.map.cells == common::OccupancyGrid::kFree) & ~hidden_free;
-  const cv::Mat1b occupied = rendered.map.cells == common::OccupancyGrid::kOccupied;
+  // A wall cell is seen when it lies within the wall's full thickness of explored free space.
+  hideUnseenRooms(hidden_free, rendered.wall_thickness / rendered.map.resolution + 1.0, &hidden.map);
+  return hidden;
+}
+
+void hideUnseenRooms(const cv::Mat1b& hidden, double seen_reach, common::OccupancyGrid* map) {
+  const cv::Mat1b visible_free = (common::trinary(*map).cells == common::OccupancyGrid::kFree) & ~hidden;
   cv::Mat1f to_visible, to_hidden;
   cv::distanceTransform(~visible_free, to_visible, cv::DIST_L2, cv::DIST_MASK_PRECISE);
-  cv::distanceTransform(~hidden_free, to_hidden, cv::DIST_L2, cv::DIST_MASK_PRECISE);
-  // A wall cell is seen when it lies within the wall's full thickness of explored free space.
-  const double thickness_cells = rendered.wall_thickness / rendered.map.resolution + 1.0;
-  const cv::Mat1b near_visible = to_visible <= static_cast<float>(thickness_cells);
-  hidden.map.cells.setTo(common::OccupancyGrid::kUnknown, hidden_free);
-  hidden.map.cells.setTo(common::OccupancyGrid::kUnknown, occupied & ~near_visible & (to_hidden < to_visible));
-  return hidden;
+  cv::distanceTransform(~hidden, to_hidden, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+  map->cells.setTo(common::OccupancyGrid::kUnknown, hidden);
+  map->cells.setTo(common::OccupancyGrid::kUnknown,
+                   (to_hidden < to_visible) & (to_visible > static_cast<float>(seen_reach)));
 }
 
 cv::Mat3b renderPreview(const Environment& environment, const RenderedEnvironment& rendered) {

@@ -68,6 +68,11 @@ struct HiddenRoomsCase {
 };
 HiddenRoomsCase hideClosedRooms(const Environment& environment, const RenderedEnvironment& rendered);
 
+// What a closed door hides of the rooms `hidden` (their cells, non-zero) in `map`: those cells become unknown, and
+// so does every cell nearer to them than to the free space left in view and more than `seen_reach` cells from it
+// (the rooms' far walls, and what a SLAM map left uncertain inside them). Free: as map_saver saves it (trinary).
+void hideUnseenRooms(const cv::Mat1b& hidden, double seen_reach, common::OccupancyGrid* map);
+
 // Colour preview for people: spaces tinted, walls black, open doors green, closed doors red with their
 // numbers.
 cv::Mat3b renderPreview(const Environment& environment, const RenderedEnvironment& rendered);
