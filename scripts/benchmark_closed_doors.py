@@ -3,7 +3,8 @@
 
 Usage: benchmark_closed_doors.py BENCH_DIR --method NAME [--methods A,B,...] [--part P] [--jobs N]
                                  [--binary PATH] [--keep DIR] [--params FILE.yaml] [--csv FILE] [--plot FILE.png]
-                                 [--agreement] [--turn DEGREES]
+                                 [--agreement] [--turn DEGREES] [--variant LABEL METHOD PARAMS.yaml]...
+                                 [--best-of]
 
 For every valid case of BENCH_DIR/cases.csv it runs `predict_rooms_offline` once per method (in parallel),
 times the whole command, reads the per-door IoU from the command's metrics.yaml and computes the thesis
@@ -13,7 +14,11 @@ peak memory per method. With --agreement it also compares each method's rooms wi
 room by room (the IoU of the method's room k with reference_rooms.png's room k; 1 when both are empty), per case
 and by number of closed doors, next to the IoU against the truth. Any folder in the benchmark's layout works,
 e.g. the cases of make_closed_door_corpus (whose cases.csv has a `part` column: --part validation). With --turn
-every case is first turned by that many degrees (map, true rooms and doors), as real SLAM maps are.
+every case is first turned by that many degrees (map, true rooms and doors), as real SLAM maps are. A --variant
+is one more column: METHOD run with the parameter overrides of PARAMS.yaml, printed as LABEL (settings compared
+side by side, on the same cases and parts). With --best-of it also prints, per part, the mean IoU the columns
+would score together if every door took the room of the column that scores best on it: how much a better choice
+among them could gain (for example among the rooms of `default`'s candidates, one variant each).
 
 Peak memory is the maximum resident set size of each command as measured by `/usr/bin/time -f %M` (GNU time),
 which wraps every run. resource.getrusage(RUSAGE_CHILDREN) is not used: on Linux a child started by this
@@ -305,11 +310,12 @@ def read_max_rss(path):
         return None
 
 
-def run_case(binary, case, method, out_root, params, timeout, agreement=False):
-    """Runs the offline command for one case and method and reads its metrics (and, with `agreement`, compares
-    its rooms with the case's reference_rooms.png)."""
-    run = Run(case, method)
-    out_dir = os.path.join(out_root, method, case.env, case.name)
+def run_case(binary, case, column, out_root, timeout, agreement=False):
+    """Runs the offline command for one case and column (label, method, parameter file or None) and reads its
+    metrics (and, with `agreement`, compares its rooms with the case's reference_rooms.png)."""
+    label, method, params = column
+    run = Run(case, label)
+    out_dir = os.path.join(out_root, label, case.env, case.name)
     log_dir = out_dir + ".log"
     shutil.rmtree(out_dir, ignore_errors=True)
     os.makedirs(log_dir, exist_ok=True)
@@ -352,19 +358,20 @@ def run_case(binary, case, method, out_root, params, timeout, agreement=False):
     return run
 
 
-def run_all(binary, cases, methods, out_root, params, jobs, timeout, agreement=False):
-    """Runs every method on every case in parallel, with a progress bar; returns {method: [Run]} in case order."""
-    tasks = [(case, method) for method in methods for case in cases]
+def run_all(binary, cases, columns, out_root, jobs, timeout, agreement=False):
+    """Runs every column (label, method, parameter file or None) on every case in parallel, with a progress bar;
+    returns {label: [Run]} in case order."""
+    tasks = [(case, column) for column in columns for case in cases]
     results = {}
     with concurrent.futures.ThreadPoolExecutor(max_workers=jobs) as pool:
-        futures = {pool.submit(run_case, binary, case, method, out_root, params, timeout, agreement): (case, method)
-                   for case, method in tasks}
+        futures = {pool.submit(run_case, binary, case, column, out_root, timeout, agreement): (case, column[0])
+                   for case, column in tasks}
         with tqdm(total=len(futures), unit="run", desc="cases", file=sys.stderr) as progress:
             for future in concurrent.futures.as_completed(futures):
-                case, method = futures[future]
-                results[(case.label, method)] = future.result()
+                case, label = futures[future]
+                results[(case.label, label)] = future.result()
                 progress.update(1)
-    return {method: [results[(case.label, method)] for case in cases] for method in methods}
+    return {label: [results[(case.label, label)] for case in cases] for label, _, _ in columns}
 
 
 # --------------------------------------------------------------------------------------------------------
@@ -499,6 +506,36 @@ def print_agreement(cases, methods, runs):
     print()
 
 
+def best_of_mean(indices, methods, runs):
+    """Mean over the cases at `indices` of the mean over their doors of the best IoU any of `methods` has on the
+    door (a failed run, or one without a door's IoU, offers nothing there)."""
+    means = []
+    for i in indices:
+        doors = max(len(runs[method][i].door_ious) for method in methods)
+        best = [max((runs[method][i].door_ious[k] for method in methods if k < len(runs[method][i].door_ious)),
+                    default=0.0) for k in range(doors)]
+        means.append(float(np.mean(best)) if best else 0.0)
+    return mean_or_none(means)
+
+
+def print_best_of(cases, methods, runs):
+    """--best-of: per part (and over all cases), each column's mean IoU and the mean IoU of the best column per
+    door."""
+    parts = sorted({case.part for case in cases if case.part})
+    groups = [(part, [i for i, case in enumerate(cases) if case.part == part]) for part in parts]
+    groups.append(("all", list(range(len(cases)))))
+    width = max(10, *(len(method) + 1 for method in methods))
+    header = "part".ljust(12) + "  cases" + "".join(method.rjust(width) for method in methods) + "best of".rjust(width)
+    print("Best column per door: the mean IoU if every door took the room of the column best on it")
+    print(header)
+    print("-" * len(header))
+    for name, indices in groups:
+        means = [mean_or_none([runs[method][i].mean_iou for i in indices]) for method in methods]
+        print(name.ljust(12) + "  %5d" % len(indices) + "".join(format_score(mean, width) for mean in means) +
+              format_score(best_of_mean(indices, methods, runs), width))
+    print()
+
+
 def print_resources(methods, runs):
     """Median and p95 wall seconds per case, and peak memory, per method."""
     print("Time per case (wall time of the whole command, successful runs) and peak memory (max RSS, /usr/bin/time)")
@@ -586,7 +623,8 @@ def parse_arguments(argv):
     parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="parallel runs (default: cores)")
     parser.add_argument("--binary", help="path of predict_rooms_offline (default: look in the workspace)")
     parser.add_argument("--keep", metavar="DIR", help="keep the outputs of every run in DIR")
-    parser.add_argument("--params", metavar="FILE.yaml", help="parameter overrides passed to every run")
+    parser.add_argument("--params", metavar="FILE.yaml",
+                        help="parameter overrides passed to every run of the methods (a --variant has its own)")
     parser.add_argument("--csv", metavar="FILE", help="write the per-case rows to FILE")
     parser.add_argument("--plot", metavar="FILE.png", help="plot mean IoU vs closed doors to FILE.png")
     parser.add_argument("--agreement", action="store_true",
@@ -594,6 +632,10 @@ def parse_arguments(argv):
     parser.add_argument("--turn", type=float, default=0.0, metavar="DEGREES",
                         help="turn every case's map, true rooms and doors by this many degrees counter-clockwise "
                              "first (as a SLAM map off the building's axes); no reference scores then")
+    parser.add_argument("--variant", nargs=3, action="append", default=[], metavar=("LABEL", "METHOD", "PARAMS.yaml"),
+                        help="one more column LABEL: METHOD with the parameter overrides of PARAMS.yaml (repeatable)")
+    parser.add_argument("--best-of", action="store_true",
+                        help="also print, per part, the mean IoU of the best column on each door")
     parser.add_argument("--timeout", type=float, default=600.0,
                         help="seconds before a run is killed and counted as failed (default 600, 0 = none)")
     args = parser.parse_args(argv)
@@ -602,17 +644,27 @@ def parse_arguments(argv):
         name = name.strip()
         if name and name not in methods:
             methods.append(name)
-    if not methods:
+    if not methods and not args.variant:
         parser.error("give at least one method with --method NAME or --methods A,B")
     if args.jobs < 1:
         parser.error("--jobs must be at least 1")
     if args.params and not os.path.isfile(args.params):
         parser.error("--params %s does not exist" % args.params)
+    params = os.path.abspath(args.params) if args.params else None
+    args.columns = [(method, method, params) for method in methods]
+    for label, method, variant_params in args.variant:
+        if not label.strip() or os.sep in label or label in [column[0] for column in args.columns]:
+            parser.error("--variant %r: give each variant a label of its own that names no folder" % label)
+        if not os.path.isfile(variant_params):
+            parser.error("--variant %s: %s does not exist" % (label, variant_params))
+        args.columns.append((label, method, os.path.abspath(variant_params)))
+    if args.best_of and len(args.columns) < 2:
+        parser.error("--best-of compares columns: give at least two methods or variants")
     if not np.isfinite(args.turn):
         parser.error("--turn must be a finite number of degrees")
     if args.turn and args.agreement:
         parser.error("--agreement compares with the reference rooms of the straight maps: not with --turn")
-    args.method_list = methods
+    args.method_list = [column[0] for column in args.columns]
     return args
 
 
@@ -622,7 +674,7 @@ def main(argv=None):
         cases = load_cases(args.bench_dir, args.part)
         binary = find_binary(args.binary)
         available = known_methods(binary)
-        unknown = [method for method in args.method_list if available is not None and method not in available]
+        unknown = sorted({method for _, method, _ in args.columns if available is not None and method not in available})
         if unknown:
             raise BenchmarkError("unknown method(s) %s; %s knows: %s" % (
                 ", ".join(unknown), BINARY_NAME, ", ".join(available)))
@@ -644,9 +696,8 @@ def main(argv=None):
         args.bench_dir, len(cases), ", turned by %g degrees" % args.turn if args.turn else "",
         ", ".join(args.method_list), args.jobs, binary))
     sys.stdout.flush()
-    params = os.path.abspath(args.params) if args.params else None
     try:
-        runs = run_all(binary, cases, args.method_list, out_root, params, args.jobs, args.timeout, args.agreement)
+        runs = run_all(binary, cases, args.columns, out_root, args.jobs, args.timeout, args.agreement)
     finally:
         if not args.keep:
             shutil.rmtree(out_root, ignore_errors=True)
@@ -657,6 +708,8 @@ def main(argv=None):
     print_overall(cases, args.method_list, runs)
     if args.agreement:
         print_agreement(cases, args.method_list, runs)
+    if args.best_of:
+        print_best_of(cases, args.method_list, runs)
     print_resources(args.method_list, runs)
     failures = print_failures(args.method_list, runs)
     if args.csv:

@@ -211,6 +211,45 @@ class SmallBenchmark(unittest.TestCase):
             self.assertAlmostEqual(reference_iou, 1.0, msg=label)
         self.assertRegex(result.stdout, r"%s: agreement mean [0-9.]+, median [0-9.]+ over 5 rooms" % self.method)
 
+    def test_variants_and_the_best_column_per_door(self):
+        """--variant adds a column of a method with its own parameters; --best-of takes per door the best column's
+        IoU, so it is at least every column's mean, and a variant that repeats a column changes nothing."""
+        folder = tempfile.mkdtemp(prefix="bench_variants_")
+        try:
+            same, grown = os.path.join(folder, "same.yaml"), os.path.join(folder, "grown.yaml")
+            with open(same, "w") as stream:
+                stream.write("default_network: 3\n")
+            with open(grown, "w") as stream:
+                stream.write("default_network: 0\ndefault_grown_area_ratio: 0\n")
+            common = [self.folder, "--binary", self.binary, "--jobs", "2", "--best-of"]
+            result = run_script(*common, "--method", "default", "--variant", "grown", "default", grown)
+            repeated = run_script(*common, "--method", "default", "--variant", "again", "default", same)
+            errors = [run_script(*common, "--method", "default"),
+                      run_script(*common, "--method", "default", "--variant", "default", "default", same),
+                      run_script(*common, "--method", "default", "--variant", "grown", "default",
+                                 os.path.join(folder, "missing.yaml"))]
+        finally:
+            shutil.rmtree(folder, ignore_errors=True)
+        self.assertEqual(result.returncode, 0, result.stdout + result.stderr)
+        self.assertEqual(repeated.returncode, 0, repeated.stdout + repeated.stderr)
+        for error in errors:
+            self.assertEqual(error.returncode, 2, error.stdout + error.stderr)
+
+        def best_of_row(stdout):
+            match = re.search(r"^all\s+(\d+)\s+([0-9.]+)\s+([0-9.]+)\s+([0-9.]+)$", stdout, re.MULTILINE)
+            self.assertIsNotNone(match, stdout)
+            return int(match.group(1)), [float(match.group(k)) for k in (2, 3, 4)]
+
+        cases, (method, variant, best) = best_of_row(result.stdout)
+        self.assertEqual(cases, len(SELECTED_CASES))
+        self.assertNotEqual(method, variant)  # the variant's parameters reached its runs
+        self.assertGreaterEqual(best, max(method, variant))
+        self.assertLessEqual(best, 1.0)
+        _, (method_again, variant_again, best_again) = best_of_row(repeated.stdout)
+        self.assertEqual(method_again, method)
+        self.assertEqual(variant_again, method)
+        self.assertEqual(best_again, method)
+
     def test_failed_case_is_reported_and_others_continue(self):
         folder = tempfile.mkdtemp(prefix="bench_broken_")
         try:
