@@ -645,7 +645,7 @@ def parse_arguments(argv):
         if name and name not in methods:
             methods.append(name)
     if not methods and not args.variant:
-        parser.error("give at least one method with --method NAME or --methods A,B")
+        parser.error("give at least one method with --method NAME, --methods A,B or --variant")
     if args.jobs < 1:
         parser.error("--jobs must be at least 1")
     if args.params and not os.path.isfile(args.params):
