@@ -26,6 +26,7 @@ import csv
 import ctypes
 import glob
 import json
+import math
 import os
 import queue
 import random
@@ -53,6 +54,9 @@ SHUTDOWN_TIMEOUT = 20.0       # wall seconds for roslaunch to stop after SIGINT
 WALL_CLOCK_EPOCH = 1e8         # seconds: no simulated run gets this far; wall-clock time (since 1970) is beyond
 PROGRESS_INTERVAL = 1.0       # wall seconds between two writes of progress.json (worker) and two bar updates
 LOCKSTEP_CHECK = 1.0          # simulated seconds between the stop rules' checks in lockstep (--realtime-factor 0)
+POSE_LOG_NAMES = ("poses_map.log", "poses_truth.log")
+POSE_PERIOD = 0.1             # simulated seconds between logged poses (the pose_logger's ~period)
+POSE_LOG_TIMEOUT = 10.0       # wall seconds the pose logs get, at the lockstep's last hold, to reach its time
 
 
 def die_with_parent():
@@ -325,7 +329,7 @@ def explore(args, out_dir, log):
     maps_dir = os.path.join(out_dir, "maps")
     os.makedirs(maps_dir, exist_ok=True)
     # The pose_logger continues existing logs (it is respawned with append): those of an earlier, unfinished run go.
-    for name in ("poses_map.log", "poses_truth.log"):
+    for name in POSE_LOG_NAMES:
         if os.path.exists(os.path.join(out_dir, name)):
             os.remove(os.path.join(out_dir, name))
     command = ["roslaunch", "-p", os.environ["ROS_MASTER_URI"].rsplit(":", 1)[1], "hidden_rooms",
@@ -392,9 +396,48 @@ def explore(args, out_dir, log):
         # and roslaunch stops (seconds of simulated time at 10x on a busy machine).
         write_progress(out_dir, "finishing", now, run.free_area, run.goals, saved, status)
         run.save_map(os.path.join(out_dir, "map"))
+        if lockstep:
+            wait_for_pose_logs(out_dir, now - POSE_PERIOD)
         return status, now
     finally:
         stop_launch(launch)
+
+
+def last_pose_time(path):
+    """The time of the last complete line of a pose log; -inf when it has none (or does not exist)."""
+    try:
+        with open(path, "rb") as log:
+            lines = [line for line in log.read().split(b"\n")[:-1] if line and not line.startswith(b"#")]
+        return float(lines[-1].split()[0]) if lines else -math.inf
+    except OSError:
+        return -math.inf
+
+
+def wait_for_pose_logs(out_dir, end):
+    """Waits (at most POSE_LOG_TIMEOUT wall seconds) until each pose log has a pose at `end` or later: the clock
+    holds, so the logger catches up with a run whose world waited for it to start (its ~lockstep)."""
+    deadline = time.monotonic() + POSE_LOG_TIMEOUT
+    while time.monotonic() < deadline:
+        if all(last_pose_time(os.path.join(out_dir, name)) >= end - 1e-6 for name in POSE_LOG_NAMES):
+            return
+        time.sleep(0.01)
+
+
+def end_pose_logs(out_dir, end):
+    """Drops the poses after `end` (and a line the stop cut) from the pose logs: what the logger wrote while the
+    run was being stopped depends on the machine, not on the run."""
+    for name in POSE_LOG_NAMES:
+        path = os.path.join(out_dir, name)
+        if not os.path.isfile(path):
+            continue
+        with open(path) as log:
+            lines = log.readlines()
+        kept = [line for line in lines if line.endswith("\n") and
+                (line.startswith("#") or not line.strip() or float(line.split()[0]) <= end + 1e-6)]
+        if len(kept) < len(lines):
+            with open(path + ".tmp", "w") as log:
+                log.writelines(kept)
+            os.replace(path + ".tmp", path)
 
 
 def post_process(args, out_dir, result):
@@ -478,6 +521,8 @@ def run_worker(args):
     with open(os.path.join(out_dir, "launch.log"), "w") as log:
         try:
             status, sim_time = explore(args, out_dir, log)
+            if args.realtime_factor == 0:
+                end_pose_logs(out_dir, sim_time - POSE_PERIOD)
             result.update(status=status, sim_time_s=round(sim_time, 1), closed_doors=args.closed)
             result["wall_time_s"] = round(time.monotonic() - started, 1)
             post_process(args, out_dir, result)

@@ -7,6 +7,7 @@
 #include <std_msgs/Bool.h>
 #include <visualization_msgs/MarkerArray.h>
 
+#include "hidden_rooms/common/geometry.h"
 #include "hidden_rooms/common/input_error.h"
 #include "hidden_rooms/common/range_scan.h"
 #include "hidden_rooms/ros/conversions.h"
@@ -158,6 +159,7 @@ void Explorer::onScan(const sensor_msgs::LaserScan::ConstPtr& scan) {
 
 void Explorer::onLockstepAck(const hidden_rooms::LockstepAck::ConstPtr& ack) {
   if (ack->node != lockstep_mapper_) return;
+  mapper_heard_ = true;
   if (!mapper_acks_.empty() && ack->stamp <= mapper_acks_.back().stamp) return;  // re-sent
   mapper_acks_.push_back(*ack);
   tryLockstepStep();
@@ -169,15 +171,20 @@ void Explorer::tryLockstepStep() {
   // The mapper's report of the scan before this one (none before the first step): it handles this one meanwhile.
   while (!mapper_acks_.empty() && mapper_acks_.front().stamp < last_step_stamp_) mapper_acks_.pop_front();
   const bool first = last_step_stamp_.isZero();
-  const bool reported = first || (!mapper_acks_.empty() && mapper_acks_.front().stamp == last_step_stamp_);
+  // A message sent before its connection is made is lost (the latched report only keeps the newest).
+  const bool connected = mapper_heard_ && map_subscriber_.getNumPublishers() > 0 &&
+                         command_publisher_.getNumSubscribers() > 0;
+  const bool reported = first ? connected
+                              : !mapper_acks_.empty() && mapper_acks_.front().stamp == last_step_stamp_;
   const ros::Time map_stamp = reported && !first ? mapper_acks_.front().map_stamp : ros::Time();
   const bool map_here = map_stamp.isZero() || (latest_map_ && latest_map_->header.stamp >= map_stamp) ||
                         (!pending_maps_.empty() && pending_maps_.back()->header.stamp >= map_stamp);
   if (!(reported && map_here)) {
     if ((ros::WallTime::now() - pending_since_).toSec() < options_.lockstep_wait) return;  // a later callback retries
-    ROS_WARN_THROTTLE(5.0, "explorer: lockstep: %s from %s for the scan at %.2f s after %.1f s (wall); stepping "
-                      "with what is here", reported ? "no map" : "no report", lockstep_mapper_.c_str(),
-                      last_step_stamp_.toSec(), options_.lockstep_wait);
+    // Not throttled: a throttle counts ROS time, which starts at 0 here, and each of these costs ~lockstep_wait.
+    ROS_WARN("explorer: lockstep: %s %s for the scan at %.2f s after %.1f s (wall); stepping with what is here",
+             first ? "not connected to" : reported ? "no map from" : "no report from", lockstep_mapper_.c_str(),
+             last_step_stamp_.toSec(), options_.lockstep_wait);
   }
   // The newest map up to the reported one (maps the mapper published later wait for their step).
   const auto due = [&](const nav_msgs::OccupancyGrid& map) {
@@ -187,7 +194,9 @@ void Explorer::tryLockstepStep() {
     applyMap(pending_maps_.front(), stamp);
     pending_maps_.pop_front();
   }
-  transform_stamp_ = reported && !first ? mapper_acks_.front().transform_stamp : ros::Time();
+  map_to_odom_.reset();
+  if (reported && !first && !mapper_acks_.front().map_to_odom.header.stamp.isZero())
+    map_to_odom_ = fromRos(mapper_acks_.front().map_to_odom.transform);
   pending_scan_.reset();
   controlStep(stamp);
   last_step_stamp_ = stamp;
@@ -224,13 +233,13 @@ bool Explorer::robotPose(const ros::Time& now, common::Pose2* pose) {
       *pose = fromRos(transform.transform);
       return true;
     }
-    // Lockstep: map -> odom as the mapper reported it, odom -> base at the scan's stamp (tf's thread brings them).
-    if (transform_stamp_.isZero()) throw tf2::LookupException("the mapper has reported no map -> odom yet");
-    waitOnWallClock([&] {
-      return tf_buffer_.canTransform(options_.map_frame, transform_stamp_, options_.base_frame, now, options_.odom_frame);
-    }, options_.lockstep_wait);
-    *pose = fromRos(tf_buffer_.lookupTransform(options_.map_frame, transform_stamp_, options_.base_frame, now,
-                                               options_.odom_frame).transform);
+    // Lockstep: map -> odom as the mapper reported it, odom -> base at the scan's stamp (tf's thread brings it; the
+    // simulator sends it again while it waits, should this node's tf connection have come late).
+    if (!map_to_odom_) throw tf2::LookupException("the mapper has reported no map -> odom yet");
+    waitOnWallClock([&] { return tf_buffer_.canTransform(options_.odom_frame, options_.base_frame, now); },
+                    options_.lockstep_wait);
+    *pose = common::composePoses(
+        *map_to_odom_, fromRos(tf_buffer_.lookupTransform(options_.odom_frame, options_.base_frame, now).transform));
     return true;
   } catch (const tf2::TransformException& error) {
     ROS_WARN_THROTTLE(5.0, "explorer: waiting for %s -> %s: %s", options_.map_frame.c_str(), options_.base_frame.c_str(),

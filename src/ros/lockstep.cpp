@@ -1,6 +1,7 @@
 #include "hidden_rooms/ros/lockstep.h"
 
 #include <ros/init.h>
+#include <ros/master.h>
 #include <ros/names.h>
 #include <ros/this_node.h>
 
@@ -20,6 +21,17 @@ LockstepAck lockstepReport(const ros::Time& stamp) {
   ack.node = ros::this_node::getName();
   ack.stamp = stamp;
   return ack;
+}
+
+bool connectedToEveryPublisher(const ros::Subscriber& subscriber) {
+  // getSystemState: [code, text, [publishers: [[topic, [node, ...]], ...], subscribers, services]].
+  XmlRpc::XmlRpcValue request, response, payload;
+  request[0] = ros::this_node::getName();
+  if (!ros::master::execute("getSystemState", request, response, payload, false)) return false;
+  for (int i = 0; i < payload[0].size(); ++i)
+    if (static_cast<std::string>(payload[0][i][0]) == subscriber.getTopic())
+      return subscriber.getNumPublishers() >= static_cast<uint32_t>(payload[0][i][1].size());
+  return false;
 }
 
 bool waitOnWallClock(const std::function<bool()>& ready, double wall_seconds) {

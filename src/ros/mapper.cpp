@@ -53,7 +53,11 @@ MapperOptions readMapperOptions(const ros::NodeHandle& nh) {
   if (options.rbpf.config_file.empty())
     throw common::InputError("~config_file", "must name the MRPT ini (config/rbpf.ini)");
   readParameters(nh, mapperNodeOptionTable(), &options);
-  if (options.lockstep) options.tf_publish_rate = 0.0;  // a timer's stamps would depend on the machine's speed
+  if (options.lockstep) {
+    options.tf_publish_rate = 0.0;  // a timer's stamps would depend on the machine's speed
+    // The scans' stamps are the clock: /clock comes on a connection of its own and may lag them.
+    options.future_stamp_tolerance = 0.0;
+  }
   return options;
 }
 
@@ -151,7 +155,9 @@ void Mapper::reportLockstep(const ros::Time& stamp) {
   ack.map_stamp = last_map_stamp_;
   {
     std::lock_guard<std::mutex> lock(transform_mutex_);
-    if (!last_tf_stamp_.isZero()) ack.transform_stamp = last_tf_stamp_ + ros::Duration(options_.transform_tolerance);
+    if (map_to_odom_ && !last_tf_stamp_.isZero())
+      ack.map_to_odom = toTransform(*map_to_odom_, options_.map_frame, options_.odom_frame,
+                                    last_tf_stamp_ + ros::Duration(options_.transform_tolerance));
   }
   lockstep_publisher_.publish(ack);
 }

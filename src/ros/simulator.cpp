@@ -75,11 +75,12 @@ bool readPose(const ros::NodeHandle& nh, const std::string& name, common::Pose2*
   return true;
 }
 
-// "a, b" -> the names resolved in the node's namespace ({"/a", "/b"}). Throws InputError for an invalid name.
-std::vector<std::string> resolvedNodeNames(const std::string& list) {
+// "a, b" -> the names resolved in the node's namespace ({"/a", "/b"}). Throws InputError("~parameter", ...) for an
+// invalid name.
+std::vector<std::string> resolvedNodeNames(const std::string& list, const std::string& parameter) {
   std::vector<std::string> names;
   for (const std::string& name : common::splitList(list))
-    if (!name.empty()) names.push_back(resolvedNodeName(name, "lockstep_nodes"));
+    if (!name.empty()) names.push_back(resolvedNodeName(name, parameter));
   return names;
 }
 
@@ -117,6 +118,9 @@ const common::OptionTable<SimulatorOptions>& simulatorNodeOptionTable() {
       {"publish_world_to_odom", &O::publish_world_to_odom, "static tf world -> odom at the start pose"},
       {"lockstep_nodes", &O::lockstep_nodes,
        "nodes (comma-separated) that must report each scan on `lockstep` before the world steps on; \"\" = none"},
+      {"lockstep_start_nodes", &O::lockstep_start_nodes,
+       "nodes (comma-separated) that must report ready on `lockstep`, after the ~lockstep_nodes have, before the "
+       "world starts (nodes that must see every message, such as the pose logger); \"\" = none"},
       {"run_until", &O::run_until, "simulated seconds to hold the clock at from the start (as the run_until "
        "service); 0 = no hold", common::atLeast(0)},
       {"lockstep_timeout", &O::lockstep_timeout, "wall seconds to wait for one scan's reports before stepping on",
@@ -214,12 +218,13 @@ Simulator::Simulator(ros::NodeHandle nh, const SimulatorOptions& options) : opti
   set_door_service_ = nh.advertiseService("set_door", &Simulator::onSetDoor, this);
   run_until_service_ = nh.advertiseService("run_until", &Simulator::onRunUntil, this);
   run_until_ = options.run_until;
-  lockstep_nodes_ = resolvedNodeNames(options.lockstep_nodes);
-  if (!lockstep_nodes_.empty()) {
+  lockstep_nodes_ = resolvedNodeNames(options.lockstep_nodes, "lockstep_nodes");
+  lockstep_start_nodes_ = resolvedNodeNames(options.lockstep_start_nodes, "lockstep_start_nodes");
+  if (!lockstep_nodes_.empty() || !lockstep_start_nodes_.empty())
     lockstep_subscriber_ = nh.subscribe("lockstep", 100, &Simulator::onLockstepAck, this);
+  if (!lockstep_nodes_.empty())
     ROS_INFO("simulator: lockstep with %s: each scan waits for their reports on %s", joined(lockstep_nodes_).c_str(),
              lockstep_subscriber_.getTopic().c_str());
-  }
   footprint_publisher_ = nh.advertise<geometry_msgs::PolygonStamped>("footprint", 1, true);
 
   footprint_.header.frame_id = options.base_frame;
@@ -245,6 +250,7 @@ ros::Time Simulator::now() const {
 }
 
 void Simulator::run() {
+  waitForStart();
   // Pacing restarts after each hold at the run_until time.
   ros::WallTime wall_start = ros::WallTime::now();
   double start = simulation_->time();
@@ -289,6 +295,31 @@ std::vector<std::string> Simulator::lockstepMissing() const {
       missing.push_back(node);
   }
   return missing;
+}
+
+void Simulator::waitForStart() {
+  if (lockstep_nodes_.empty() && lockstep_start_nodes_.empty()) return;
+  const ros::WallTime started = ros::WallTime::now();
+  const auto wait = [&](const std::vector<std::string>& nodes, const char* what) {
+    const auto missing = [&] {
+      std::vector<std::string> names;
+      for (const std::string& node : nodes)
+        if (!lockstep_acks_.count(node)) names.push_back(node);
+      return names;
+    };
+    while (!missing().empty() && ros::ok()) {
+      if ((ros::WallTime::now() - started).toSec() > options_.lockstep_timeout) {
+        ROS_WARN("simulator: lockstep: %s %s not ready in %.0f s (wall); starting without them", what,
+                 joined(missing()).c_str(), options_.lockstep_timeout);
+        return;
+      }
+      ros::getGlobalCallbackQueue()->callAvailable(ros::WallDuration(0.01));
+    }
+  };
+  wait(lockstep_nodes_, "nodes");
+  // Only a report sent once the lockstep nodes are up counts: it says its sender hears their publications too.
+  for (const std::string& node : lockstep_start_nodes_) lockstep_acks_.erase(node);
+  wait(lockstep_start_nodes_, "start nodes");
 }
 
 void Simulator::waitForLockstep() {

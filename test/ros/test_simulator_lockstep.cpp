@@ -1,6 +1,7 @@
-// rostest: the simulator in lockstep with this test node (test/ros/simulator_lockstep.test). The world steps on
-// only after the node reports each scan and the commands it reports have arrived; an unreported scan is re-sent
-// and, after ~lockstep_timeout, the world steps on anyway; run_until holds the clock and refuses bad times.
+// rostest: the simulator in lockstep with this test node (test/ros/simulator_lockstep.test). The world starts once
+// the node and a start node (whose ready report this node sends) have reported ready; it steps on only after the
+// node reports each scan and the commands it reports have arrived; an unreported scan is re-sent and, after
+// ~lockstep_timeout, the world steps on anyway; run_until holds the clock and refuses bad times.
 #include <cmath>
 #include <limits>
 #include <string>
@@ -21,9 +22,14 @@ namespace {
 
 using hidden_rooms::testing::spinUntil;
 
+const std::string kLockstepNode = "/test_ros_simulator_lockstep";  // the launch file's ~lockstep_nodes
+const std::string kStartNode = "/start_node";                      // and its ~lockstep_start_nodes
+
 class SimulatorLockstepTest : public ::testing::Test {
  protected:
   void SetUp() override {
+    // rostest names the node after the test: were it another, the world would step on timeouts alone.
+    ASSERT_EQ(ros::this_node::getName(), kLockstepNode);
     scan_subscriber_ = nh_.subscribe<sensor_msgs::LaserScan>(
         "base_scan", 100, [this](const sensor_msgs::LaserScan::ConstPtr& m) { scans_.push_back(m->header.stamp); });
     clock_subscriber_ = nh_.subscribe<rosgraph_msgs::Clock>(
@@ -33,12 +39,21 @@ class SimulatorLockstepTest : public ::testing::Test {
     ack_publisher_ = nh_.advertise<hidden_rooms::LockstepAck>("lockstep", 10, true);
     command_publisher_ = nh_.advertise<geometry_msgs::Twist>("cmd_vel", 10);
     ASSERT_TRUE(ros::service::waitForService("run_until", ros::Duration(30.0)));
+    // Latched, the topic keeps one report per publisher: this one sends the start node's too, so none may go out
+    // before the simulator listens.
+    ASSERT_TRUE(spinUntil([this] { return ack_publisher_.getNumSubscribers() > 0; }, 30.0));
+  }
+
+  // Reports ready as this node, then as the start node, and waits for the first scan.
+  void startWorld() {
+    report(ros::Time());
+    report(ros::Time(), false, kStartNode);
     ASSERT_TRUE(spinUntil([this] { return !scans_.empty(); }, 30.0)) << "no scan";
   }
 
-  void report(const ros::Time& stamp, bool finished = false) {
+  void report(const ros::Time& stamp, bool finished = false, const std::string& node = ros::this_node::getName()) {
     hidden_rooms::LockstepAck ack;
-    ack.node = ros::this_node::getName();
+    ack.node = node;
     ack.stamp = stamp;
     ack.commands = commands_;
     ack.finished = finished;
@@ -69,7 +84,22 @@ class SimulatorLockstepTest : public ::testing::Test {
   uint32_t commands_ = 0;
 };
 
+// Run first: the world has not started yet.
+TEST_F(SimulatorLockstepTest, StartsOnceItsNodesAndThenItsStartNodesAreReady) {
+  spinUntil([] { return false; }, 1.0);
+  EXPECT_TRUE(scans_.empty()) << "started before any node was ready";
+  EXPECT_TRUE(clock_.isZero());
+  report(ros::Time(), false, kStartNode);  // before the lockstep node: does not count
+  report(ros::Time());
+  spinUntil([] { return false; }, 1.0);
+  EXPECT_TRUE(scans_.empty()) << "started on a start node's report sent before the lockstep nodes were ready";
+  report(ros::Time(), false, kStartNode);
+  ASSERT_TRUE(spinUntil([this] { return !scans_.empty(); }, 5.0)) << "did not start when every node was ready";
+  EXPECT_NEAR(scans_.front().toSec(), 0.1, 1e-6);
+}
+
 TEST_F(SimulatorLockstepTest, StepsOneScanPerReportWaitsForCommandsAndRunsUntilAHold) {
+  startWorld();
   // Unreported, the first scan is re-sent (to nodes that subscribed late) and the clock stays at it.
   ASSERT_TRUE(spinUntil([this] { return scans_.size() >= 2; }, 5.0)) << "the unreported scan was not re-sent";
   EXPECT_EQ(scans_[0], scans_[1]);
@@ -124,12 +154,13 @@ TEST_F(SimulatorLockstepTest, StepsOneScanPerReportWaitsForCommandsAndRunsUntilA
 }
 
 TEST_F(SimulatorLockstepTest, AnUnreportedScanIsGivenUpAfterTheTimeout) {
+  startWorld();
   EXPECT_TRUE(runUntil(0.0).response.success);
   ASSERT_GT(stepOnce(), 0.0);  // a fresh scan: the wait for its report starts now
   const ros::Time silent = scans_.back();
   const ros::WallTime started = ros::WallTime::now();
-  ASSERT_TRUE(spinUntil([&] { return scans_.back() > silent; }, 10.0)) << "the world waited past the timeout";
-  EXPECT_GT((ros::WallTime::now() - started).toSec(), 2.0);  // ~lockstep_timeout is 3 s
+  ASSERT_TRUE(spinUntil([&] { return scans_.back() > silent; }, 20.0)) << "the world waited past the timeout";
+  EXPECT_GT((ros::WallTime::now() - started).toSec(), 9.0);  // ~lockstep_timeout is 10 s
 }
 
 }  // namespace

@@ -68,7 +68,8 @@ class Explorer {
   // The control step at ROS time `now`: checks the map, pose and scan, updates the policy, publishes.
   void controlStep(const ros::Time& now);
   // Lockstep: takes the control step of the pending scan once the mapper's results for the scan before it (its
-  // report, the map it names, map -> odom) are here, or after ~lockstep_wait without them; then reports.
+  // report, the map it names) are here, or after ~lockstep_wait without them; then reports. The first step waits
+  // until the mapper's reports and maps and the simulator's cmd_vel are connected, so that none is missed.
   void tryLockstepStep();
   void reportLockstep(const ros::Time& stamp);
   bool robotPose(const ros::Time& now, common::Pose2* pose);
@@ -115,7 +116,8 @@ class Explorer {
   sensor_msgs::LaserScan::ConstPtr pending_scan_;  // the scan whose step is due
   ros::WallTime pending_since_;
   ros::Time last_step_stamp_;       // stamp of the last scan stepped
-  ros::Time transform_stamp_;       // map -> odom stamp of the step's pose (the mapper's report)
+  bool mapper_heard_ = false;       // a report of the mapper's has come (its `lockstep` reaches this node)
+  std::optional<common::Pose2> map_to_odom_;  // map -> odom of the step's pose (the mapper's report)
   uint32_t commands_published_ = 0;
 };
 

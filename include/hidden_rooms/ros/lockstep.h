@@ -7,6 +7,7 @@
 #include <string>
 
 #include <hidden_rooms/LockstepAck.h>
+#include <ros/subscriber.h>
 #include <ros/time.h>
 
 namespace hidden_rooms {
@@ -17,6 +18,10 @@ std::string resolvedNodeName(const std::string& name, const std::string& paramet
 
 // This node's report of the scan stamped `stamp` (0: ready); the caller fills in the other fields.
 LockstepAck lockstepReport(const ros::Time& stamp);
+
+// Whether `subscriber` is connected to every publisher the master lists for its topic, and there is one (a message
+// published once this holds reaches it). Asks the master: not for every message.
+bool connectedToEveryPublisher(const ros::Subscriber& subscriber);
 
 // Polls `ready` until it holds or `wall_seconds` of wall time have passed; whether it held. (tf2's own timeouts run
 // on ROS time, which stands still while the simulator waits for the lockstep reports.)

@@ -7,8 +7,8 @@
 
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
+#include <tf2_msgs/TFMessage.h>
 #include <tf2_ros/buffer.h>
-#include <tf2_ros/transform_listener.h>
 
 #include "hidden_rooms/common/options.h"
 
@@ -25,6 +25,10 @@ struct PoseLoggerOptions {
   // Continue existing logs (a respawned logger) instead of starting them afresh: a line cut by a kill is
   // removed, poses at or before a log's last time are not logged again.
   bool append = false;
+  // Lockstep (explore.launch at realtime_factor 0): until the clock runs, report ready on `lockstep` while subscribed
+  // to every publisher of tf and of the ground-truth topic, so that the simulator's ~lockstep_start_nodes can wait
+  // until no pose of the run can be missed.
+  bool lockstep = false;
 };
 
 // The node's parameters, as docs/ros_api.md lists them.
@@ -46,16 +50,28 @@ class PoseLogger {
   long long groundTruthLogged() const { return ground_truth_logged_; }
 
  private:
-  void onTimer(const ros::TimerEvent& event);
+  // Logs the estimates of the grid times up to ROS time now that tf can give (or that it gave up on).
+  void logEstimates();
+  // Lockstep: whether the transforms of the grid time `time` may still come: tf has none after it yet, and it has
+  // waited less than kLockstepGiveUpWall of wall time since its first try.
+  bool transformsLate(const ros::Time& time);
   void onGroundTruth(const nav_msgs::Odometry::ConstPtr& message);
+  void onReadyTimer(const ros::WallTimerEvent& event);
+  void addTransforms(const tf2_msgs::TFMessage& message, bool is_static);
 
   PoseLoggerOptions options_;
   std::ofstream estimate_log_;
   std::ofstream ground_truth_log_;
   tf2_ros::Buffer tf_buffer_;
-  tf2_ros::TransformListener tf_listener_;
+  // tf2_ros's listener, on this node's queue with room for a burst (see kTransformQueue).
+  ros::Subscriber tf_subscriber_;
+  ros::Subscriber tf_static_subscriber_;
   ros::Subscriber ground_truth_subscriber_;
-  ros::Timer timer_;
+  ros::Timer timer_;          // logEstimates every ~period of ROS time
+  ros::WallTimer wall_timer_;  // lockstep: logEstimates every 0.02 s of wall time instead
+  ros::WallTime first_try_;    // lockstep: when the grid time due was first tried after kGiveUpDelay
+  ros::Publisher lockstep_publisher_;  // lockstep: the ready reports
+  ros::WallTimer ready_timer_;
   double next_estimate_time_ = 0.0;  // next grid time to log (seconds); 0 = not started
   ros::Time last_ground_truth_stamp_;
   // The last pose already in a continued log (seconds); -infinity for a new log.

@@ -41,6 +41,9 @@ struct SimulatorOptions {
   // Lockstep: nodes (names, comma-separated, resolved in the node's namespace) that must report each scan on
   // `lockstep` (and whose reported cmd_vel must have arrived) before the world steps on; "" = free-running.
   std::string lockstep_nodes;
+  // Nodes that must report ready on `lockstep`, after the lockstep nodes have, before the world starts: nodes that
+  // must see every message from the first (the pose logger's ~lockstep); "" = none.
+  std::string lockstep_start_nodes;
   double run_until = 0.0;          // simulated seconds to hold the clock at until run_until asks for more; 0 = none
   double lockstep_timeout = 30.0;  // wall seconds to wait for the reports of one scan before stepping on anyway
   std::string world_frame = "world";
@@ -62,10 +65,11 @@ SimulatorOptions readSimulatorOptions(const ros::NodeHandle& private_nh);
 
 // Stage/stage_ros's job on the core's Box2D simulation: steps the world with a fixed physics step at
 // `realtime_factor`, publishes /clock, base_scan, odom, base_pose_ground_truth and tf, follows cmd_vel, and
-// serves reset, set_door and run_until (hold the clock at a time). In lockstep (~lockstep_nodes) it waits after
-// each scan until every named node has reported it on `lockstep` and their commands have arrived, re-sending the
-// scan with its clock and odometry every second meanwhile (to a node that subscribed late): the same seed then
-// gives the same run however fast the machine is.
+// serves reset, set_door and run_until (hold the clock at a time). In lockstep (~lockstep_nodes) it starts once
+// those nodes and the ~lockstep_start_nodes have reported ready, and waits after each scan until every lockstep
+// node has reported it on `lockstep` and their commands have arrived, re-sending the scan with its clock and
+// odometry every second meanwhile (to a node that subscribed late): the same seed then gives the same run however
+// fast the machine is.
 class Simulator {
  public:
   // Loads the world and builds the simulation (throws InputError when it cannot); does not wait for anything.
@@ -87,6 +91,9 @@ class Simulator {
   bool holding() const;
   // Lockstep nodes that have not yet reported the last scan (or whose reported commands have not arrived).
   std::vector<std::string> lockstepMissing() const;
+  // Before the first step: handles callbacks until every lockstep node has reported, then until every start node
+  // has reported again (at most ~lockstep_timeout in all; then it warns, naming them, and starts).
+  void waitForStart();
   // Handles callbacks until lockstepMissing() is empty, re-sending the last scan every wall second; after
   // ~lockstep_timeout it warns, naming the nodes, and returns.
   void waitForLockstep();
@@ -107,6 +114,7 @@ class Simulator {
   sensor_msgs::LaserScan last_scan_;
   geometry_msgs::TransformStamped last_odometry_transform_;
   std::vector<std::string> lockstep_nodes_;  // resolved names
+  std::vector<std::string> lockstep_start_nodes_;
   std::map<std::string, hidden_rooms::LockstepAck> lockstep_acks_;  // each node's last report
   std::map<std::string, uint32_t> commands_received_;  // cmd_vel messages by publisher
   bool lockstep_waiting_ = false;
