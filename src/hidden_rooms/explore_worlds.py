@@ -26,7 +26,6 @@ import csv
 import ctypes
 import glob
 import json
-import math
 import os
 import queue
 import random
@@ -403,23 +402,24 @@ def explore(args, out_dir, log):
         stop_launch(launch)
 
 
-def last_pose_time(path):
-    """The time of the last complete line of a pose log; -inf when it has none (or does not exist)."""
+def pose_log_lines(path):
+    """The complete lines of a pose log (a line a kill cut has no newline) as (time, line), the header's as
+    (None, line); [] when the log does not exist."""
     try:
-        with open(path, "rb") as log:
-            lines = [line for line in log.read().split(b"\n")[:-1] if line and not line.startswith(b"#")]
-        return float(lines[-1].split()[0]) if lines else -math.inf
-    except OSError:
-        return -math.inf
+        with open(path) as log:
+            return [(None if line.startswith("#") or not line.strip() else float(line.split()[0]), line)
+                    for line in log if line.endswith("\n")]
+    except FileNotFoundError:
+        return []
 
 
 def wait_for_pose_logs(out_dir, end):
     """Waits (at most POSE_LOG_TIMEOUT wall seconds) until each pose log has a pose at `end` or later: the clock
     holds, so the logger catches up with a run whose world waited for it to start (its ~lockstep)."""
+    def reached(name):
+        return any(t is not None and t >= end - 1e-6 for t, _ in pose_log_lines(os.path.join(out_dir, name)))
     deadline = time.monotonic() + POSE_LOG_TIMEOUT
-    while time.monotonic() < deadline:
-        if all(last_pose_time(os.path.join(out_dir, name)) >= end - 1e-6 for name in POSE_LOG_NAMES):
-            return
+    while time.monotonic() < deadline and not all(reached(name) for name in POSE_LOG_NAMES):
         time.sleep(0.01)
 
 
@@ -430,14 +430,10 @@ def end_pose_logs(out_dir, end):
         path = os.path.join(out_dir, name)
         if not os.path.isfile(path):
             continue
-        with open(path) as log:
-            lines = log.readlines()
-        kept = [line for line in lines if line.endswith("\n") and
-                (line.startswith("#") or not line.strip() or float(line.split()[0]) <= end + 1e-6)]
-        if len(kept) < len(lines):
-            with open(path + ".tmp", "w") as log:
-                log.writelines(kept)
-            os.replace(path + ".tmp", path)
+        kept = [line for t, line in pose_log_lines(path) if t is None or t <= end + 1e-6]
+        with open(path + ".partial", "w") as log:
+            log.writelines(kept)
+        os.replace(path + ".partial", path)
 
 
 def post_process(args, out_dir, result):
