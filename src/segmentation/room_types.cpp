@@ -190,7 +190,8 @@ RoomTypeClassifier RoomTypeClassifier::fromText(const std::string& model_text, c
   return RoomTypeClassifier(forest);
 }
 
-RoomTypeClassifier RoomTypeClassifier::train(const cv::Mat1f& features, const std::vector<int>& types) {
+RoomTypeClassifier RoomTypeClassifier::train(const cv::Mat1f& features, const std::vector<int>& types, uint64_t seed) {
+  cv::theRNG().state = seed;  // ml::RTrees draws from the thread's generator
   cv::Ptr<cv::ml::RTrees> forest = cv::ml::RTrees::create();
   forest->setMaxDepth(8);
   forest->setMinSampleCount(5);
@@ -203,9 +204,21 @@ RoomTypeClassifier RoomTypeClassifier::train(const cv::Mat1f& features, const st
 std::vector<int> RoomTypeClassifier::classify(const cv::Mat1f& features) const {
   std::vector<int> types;
   if (features.empty()) return types;
-  cv::Mat predictions;
-  forest_->predict(features, predictions);
-  for (int row = 0; row < predictions.rows; ++row) types.push_back(static_cast<int>(std::lround(predictions.at<float>(row))));
+  // A room is a corridor when most trees say so, else of the room type with most votes: a plurality over the
+  // seven types would call it a corridor whenever the room votes split among the six room types.
+  cv::Mat votes;  // a header row of class labels, then a row of vote counts per sample
+  forest_->getVotes(features, votes, 0);
+  const int corridor = 0;
+  for (int row = 1; row < votes.rows; ++row) {
+    int corridor_votes = 0, all_votes = 0, room_type = -1, room_type_votes = -1;
+    for (int col = 0; col < votes.cols; ++col) {
+      const int type = votes.at<int>(0, col), count = votes.at<int>(row, col);
+      all_votes += count;
+      if (type == corridor) corridor_votes = count;
+      else if (count > room_type_votes) room_type_votes = count, room_type = type;
+    }
+    types.push_back(2 * corridor_votes > all_votes || room_type < 0 ? corridor : room_type);
+  }
   return types;
 }
 

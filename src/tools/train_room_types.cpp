@@ -1,4 +1,4 @@
-// train_room_types --environments DIR --out MODEL.yml [--folds K]: trains the room type model on the labelled
+// train_room_types --environments DIR --out MODEL.yml [--folds K] [--repeats R]: trains the room type model on the labelled
 // environments of DIR (each rendered with its doors open and segmented; a found room takes the label of the space
 // that overlaps it most), reports its accuracy cross-validated by environment, and writes the model trained on all.
 #include <iomanip>
@@ -45,21 +45,23 @@ std::vector<int> trueTypes(const segmentation::SegmentedFloor& floor, const cv::
 
 int run(int argc, char** argv) {
   std::string environments_dir, out_path, method = "default";
-  int folds = 5;
+  int folds = 5, repeats = 1;
   po::options_description options("Options");
   options.add_options()
       ("environments", po::value(&environments_dir)->required(), "folder of labelled environment XMLs (recursive)")
       ("out", po::value(&out_path)->required(), "the model file to write (OpenCV FileStorage YAML)")
       ("method", po::value(&method)->default_value(method), "segmentation method the rooms come from")
-      ("folds", po::value(&folds)->default_value(folds), "cross-validation folds (environments split round robin)");
+      ("folds", po::value(&folds)->default_value(folds), "cross-validation folds (environments split round robin)")
+      ("repeats", po::value(&repeats)->default_value(repeats), "cross-validations, each with its own forest seed");
   po::variables_map values;
   if (!common::parseCommandLine(argc, argv,
-                                "Usage: train_room_types --environments DIR --out MODEL.yml [--folds K]\n"
+                                "Usage: train_room_types --environments DIR --out MODEL.yml [--folds K] [--repeats R]\n"
                                 "Trains the room type model and prints its accuracy per type, cross-validated by\n"
                                 "environment (no environment's rooms are in the training set of its own fold).",
                                 options, {}, &values))
     return common::kExitOk;
   if (folds < 2) throw common::InputError("--folds", "must be at least 2");
+  if (repeats < 1) throw common::InputError("--repeats", "must be at least 1");
   const std::vector<std::string> paths = common::listFiles(environments_dir, ".xml", true);
   if (static_cast<int>(paths.size()) < folds) throw common::InputError(environments_dir, "has fewer environments than folds");
 
@@ -81,35 +83,40 @@ int run(int argc, char** argv) {
     }
   }
 
+  // Cross-validation, once per forest seed: the accuracies are the means over the repeats.
   const std::vector<std::string>& names = segmentation::roomTypeNames();
   std::vector<int> total(names.size(), 0), correct(names.size(), 0);
   int kind_correct = 0;
-  for (int fold = 0; fold < folds; ++fold) {
-    cv::Mat1f train_features, test_features;
-    std::vector<int> train_types, test_types;
-    for (size_t i = 0; i < samples.size(); ++i) {
-      const bool test = samples[i].environment % folds == fold;
-      (test ? test_features : train_features).push_back(features.row(static_cast<int>(i)));
-      (test ? test_types : train_types).push_back(samples[i].type);
-    }
-    const std::vector<int> found =
-        segmentation::RoomTypeClassifier::train(train_features, train_types).classify(test_features);
-    for (size_t i = 0; i < found.size(); ++i) {
-      ++total[test_types[i]];
-      correct[test_types[i]] += found[i] == test_types[i];
-      kind_correct += (found[i] == 0) == (test_types[i] == 0);  // type 0: corridor
+  for (int repeat = 0; repeat < repeats; ++repeat) {
+    for (int fold = 0; fold < folds; ++fold) {
+      cv::Mat1f train_features, test_features;
+      std::vector<int> train_types, test_types;
+      for (size_t i = 0; i < samples.size(); ++i) {
+        const bool test = samples[i].environment % folds == fold;
+        (test ? test_features : train_features).push_back(features.row(static_cast<int>(i)));
+        (test ? test_types : train_types).push_back(samples[i].type);
+      }
+      const std::vector<int> found =
+          segmentation::RoomTypeClassifier::train(train_features, train_types, repeat + 1).classify(test_features);
+      for (size_t i = 0; i < found.size(); ++i) {
+        ++total[test_types[i]];
+        correct[test_types[i]] += found[i] == test_types[i];
+        kind_correct += (found[i] == 0) == (test_types[i] == 0);  // type 0: corridor
+      }
     }
   }
+  const double tested = static_cast<double>(samples.size()) * repeats;
   std::cout << std::fixed << std::setprecision(3) << samples.size() << " rooms of " << paths.size()
-            << " environments, " << folds << "-fold cross-validation by environment\n";
+            << " environments, " << folds << "-fold cross-validation by environment, " << repeats
+            << (repeats == 1 ? " forest seed\n" : " forest seeds (mean)\n");
   int all_correct = 0;
   for (size_t t = 0; t < names.size(); ++t) {
     all_correct += correct[t];
-    std::cout << "  " << std::left << std::setw(10) << names[t] << std::right << std::setw(6) << total[t]
+    std::cout << "  " << std::left << std::setw(10) << names[t] << std::right << std::setw(6) << total[t] / repeats
               << " rooms, accuracy " << (total[t] > 0 ? static_cast<double>(correct[t]) / total[t] : 0.0) << "\n";
   }
-  std::cout << "  type accuracy " << static_cast<double>(all_correct) / samples.size() << ", corridor/room accuracy "
-            << static_cast<double>(kind_correct) / samples.size() << "\n";
+  std::cout << "  type accuracy " << all_correct / tested << ", corridor/room accuracy " << kind_correct / tested
+            << "\n";
 
   const std::string text = segmentation::RoomTypeClassifier::train(features, [&] {
     std::vector<int> types;

@@ -8,6 +8,7 @@
 #include "hidden_rooms/segmentation/floor_output.h"
 #include "hidden_rooms/segmentation/room_graph.h"
 #include "hidden_rooms/segmentation/room_segmenter.h"
+#include "hidden_rooms/segmentation/room_types.h"
 #include "hidden_rooms/segmentation/segmentation_metrics.h"
 #include "hidden_rooms/world/environment.h"
 #include "test_util.h"
@@ -234,6 +235,27 @@ TEST(RoomGraph, ClosedDoorsAreBordersAndPredictedRoomsAreNodes) {
   EXPECT_NE(closed->room_b, 0);
   EXPECT_EQ(predicted->room_a, corridor);
   EXPECT_EQ(predicted->room_b, floor.rooms.back().label);
+}
+
+// A room is a corridor only when most trees say so. On features that tell nothing (noise), each tree votes for
+// about the type of a random training room: with a fifth of them corridors and the rest split evenly among the six
+// room types, a plurality over seven types would call most rooms corridors; most trees never agree on it.
+TEST(RoomTypes, ACorridorNeedsMostOfTheVotes) {
+  cv::RNG noise(7);
+  const auto noiseRows = [&](int rows) {
+    cv::Mat1f features(rows, static_cast<int>(roomFeatureNames().size()));
+    noise.fill(features, cv::RNG::UNIFORM, 0.0, 1.0);
+    return features;
+  };
+  std::vector<int> types;
+  for (int type = 0; type < static_cast<int>(roomTypeNames().size()); ++type)
+    types.insert(types.end(), type == 0 ? 60 : 40, type);
+  const RoomTypeClassifier classifier = RoomTypeClassifier::train(noiseRows(static_cast<int>(types.size())), types);
+  const std::vector<int> found = classifier.classify(noiseRows(200));
+  ASSERT_EQ(found.size(), 200u);
+  const int corridors = static_cast<int>(std::count(found.begin(), found.end(), 0));
+  EXPECT_LT(corridors, 20) << "rooms called corridors on noise: " << corridors;
+  for (const int type : found) EXPECT_LT(type, static_cast<int>(roomTypeNames().size()));
 }
 
 TEST(RoomGraph, TheEnvironmentXmlReadsBackWithTheSameRoomsAndDoors) {

@@ -4,6 +4,7 @@
 // place in the topological map (doors, neighbours) as features, a random forest (OpenCV ml) as classifier. The
 // shipped model (models/room_types.yml.gz, built into the library) is trained by train_room_types.
 
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -36,8 +37,9 @@ class RoomTypeClassifier {
   static const RoomTypeClassifier& shipped();
   // A model as train_room_types writes it (OpenCV FileStorage text). Throws InputError when it does not read.
   static RoomTypeClassifier fromText(const std::string& model_text, const std::string& source_name);
-  // Trains on `features` (roomFeatures rows) with `types` (indices into roomTypeNames()).
-  static RoomTypeClassifier train(const cv::Mat1f& features, const std::vector<int>& types);
+  // Trains on `features` (roomFeatures rows) with `types` (indices into roomTypeNames()); the forest draws its
+  // samples and split features from `seed`, so the same arguments give the same model.
+  static RoomTypeClassifier train(const cv::Mat1f& features, const std::vector<int>& types, uint64_t seed = 1);
 
   // The type index of each row of `features`.
   std::vector<int> classify(const cv::Mat1f& features) const;
