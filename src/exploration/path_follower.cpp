@@ -43,6 +43,8 @@ const common::OptionTable<PathFollowerOptions>& pathFollowerOptionTable() {
        non_negative},
       {"doorway_angular_velocity", &O::doorway_angular_velocity, "rad/s: the turn rate cap in a doorway",
        non_negative},
+      {"gap_slack", &O::gap_slack, "metres: in a gap with less to spare beside the lane, aim at its middle; 0 = off",
+       non_negative},
       {"stall_timeout", &O::stall_timeout, "seconds without stall_distance or stall_angle start a recovery",
        positive},
       {"stall_distance", &O::stall_distance, "metres", non_negative},
@@ -334,6 +336,28 @@ bool PathFollower::inDoorway(const std::vector<common::Point2>& obstacles) const
   return left && right;
 }
 
+common::Point2 PathFollower::centredInGap(const std::vector<common::Point2>& obstacles,
+                                          const common::Point2& local) const {
+  const double distance = local.norm();
+  if (options_.gap_slack <= 0.0 || distance < 1e-6) return local;
+  const common::Point2 along = local / distance, across(-along.y(), along.x());
+  const double half_length = 0.5 * options_.footprint_length;
+  const double widest = options_.footprint_width + 2.0 * (options_.side_margin + options_.gap_slack);
+  // The nearest points on either side of the way, from beside the footprint to past the pursued point.
+  double left = kInfinity, right = kInfinity;
+  for (const common::Point2& point : obstacles) {
+    if (!point.allFinite()) continue;
+    const double a = point.dot(along), c = point.dot(across);
+    if (a < -half_length || a > distance + half_length || std::abs(c) > widest) continue;
+    if (c >= 0.0) left = std::min(left, c);
+    else right = std::min(right, -c);
+  }
+  const double width = left + right;
+  // No gap, one the robot cannot pass, or one with room to spare.
+  if (!(width >= options_.footprint_width && width <= widest)) return local;
+  return local + across * (0.5 * (left - right));
+}
+
 common::VelocityCommand PathFollower::turnInPlace(double angular, const std::vector<common::Point2>& obstacles,
                                                   double front_clearance) const {
   const double half_length = 0.5 * options_.footprint_length, half_width = 0.5 * options_.footprint_width;
@@ -372,7 +396,7 @@ FollowerStep PathFollower::follow(const common::Pose2& pose, const std::vector<c
       target = path_[i];
       break;
     }
-  const common::Point2 local = toRobotFrame(pose, target);
+  const common::Point2 local = centredInGap(obstacles, toRobotFrame(pose, target));
   const double heading_error = std::atan2(local.y(), local.x());
   if (std::abs(heading_error) > options_.rotate_in_place_angle) {
     step.command = turnInPlace(std::clamp(options_.heading_gain * heading_error, -options_.max_angular_velocity,

@@ -114,6 +114,34 @@ TEST(PathFollower, TurnsSlowlyInADoorway) {
   EXPECT_NEAR(step.command.angular, options.doorway_angular_velocity, 1e-9);
 }
 
+// Jambs of a gap `width` wide whose middle lies `offset` metres left of the path, `distance` ahead (robot frame).
+std::vector<common::Point2> gapAhead(double distance, double width, double offset) {
+  std::vector<common::Point2> points;
+  for (double y = 0.5 * width; y <= 1.5; y += 0.02) {
+    points.emplace_back(distance, offset + y);
+    points.emplace_back(distance, offset - y);
+  }
+  return points;
+}
+
+TEST(PathFollower, AimsAtTheMiddleOfANarrowGap) {
+  PathFollowerOptions options;
+  options.arc_horizon = 0.0;  // the pursuit alone
+  PathFollower follower(options);
+  follower.setPath(straightPath(5.0), 0.0);
+  // A 0.70 m gap (lane 0.605 m) 0.5 m ahead, its middle 0.06 m left of the path: the robot turns left towards it.
+  EXPECT_GT(follower.update(common::Pose2{}, gapAhead(0.5, 0.70, 0.06), 0.1).command.angular, 0.05);
+  EXPECT_LT(follower.update(common::Pose2{}, gapAhead(0.5, 0.70, -0.06), 0.2).command.angular, -0.05);
+  // A wide door (1 m) or the option off: the path is followed as it is.
+  EXPECT_NEAR(follower.update(common::Pose2{}, gapAhead(0.5, 1.0, 0.06), 0.3).command.angular, 0.0, 1e-9);
+  options.gap_slack = 0.0;
+  PathFollower plain(options);
+  plain.setPath(straightPath(5.0), 0.0);
+  EXPECT_NEAR(plain.update(common::Pose2{}, gapAhead(0.5, 0.70, 0.06), 0.1).command.angular, 0.0, 1e-9);
+  // A gap narrower than the robot is no way through: not aimed at.
+  EXPECT_NEAR(follower.update(common::Pose2{}, gapAhead(0.5, 0.45, 0.06), 0.4).command.angular, 0.0, 1e-9);
+}
+
 TEST(PathFollower, SlowsDownAndStopsInFrontOfAnObstacle) {
   PathFollowerOptions options;
   PathFollower follower(options);

@@ -37,6 +37,10 @@ struct PathFollowerOptions {
   // the frame.
   double doorway_distance = 0.3;
   double doorway_angular_velocity = 0.15;
+  // A narrow gap on the way to the pursued point (laser points on both sides of that way, at least the footprint's
+  // width apart and at most the lane's plus gap_slack metres each side): the robot aims at the middle between
+  // them, where the map's gap may lie a few centimetres off the real one. 0 = off.
+  double gap_slack = 0.1;
   // Recovery: not moving (less than stall_distance and stall_angle) for stall_timeout seconds while it should
   // triggers a recovery: back off for backoff_time at backoff_velocity (when the laser sees room behind), then
   // turn in place towards the freer side for recovery_rotate_time. When the last recovery (of any goal) did not
@@ -139,6 +143,8 @@ class PathFollower {
                        double max_distance) const;
   // Laser points beside both sides of the footprint within doorway_distance.
   bool inDoorway(const std::vector<common::Point2>& obstacles) const;
+  // `local` (the pursued point, robot frame) moved across the way to it into the middle of a narrow gap.
+  common::Point2 centredInGap(const std::vector<common::Point2>& obstacles, const common::Point2& local) const;
   // Turning in place at `angular`, with laser points inside the circle the footprint sweeps (+ side_margin): on
   // the front half only, also backing away at creep_velocity (rear lane free); on the rear half only, creeping
   // forward (lane ahead free); on both halves, creeping straight ahead without turning (lane ahead free).
