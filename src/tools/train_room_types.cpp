@@ -1,6 +1,7 @@
-// train_room_types --environments DIR --out MODEL.yml [--folds K] [--repeats R]: trains the room type model on the labelled
-// environments of DIR (each rendered with its doors open and segmented; a found room takes the label of the space
-// that overlaps it most), reports its accuracy cross-validated by environment, and writes the model trained on all.
+// train_room_types --environments DIR --out MODEL.yml [--folds K] [--repeats R]: trains the room type model on the
+// labelled environments of DIR (each rendered with its doors open and segmented; a found room takes the label of the
+// space that overlaps it most), reports its accuracy cross-validated by environment (the mean over R forest seeds),
+// and writes the model trained on all.
 #include <iomanip>
 #include <iostream>
 #include <algorithm>
