@@ -40,7 +40,8 @@ ExplorationPolicy::ExplorationPolicy(const ExplorationPolicyOptions& options)
       planner_(options.planner),
       follower_(options.follower),
       passages_(options.passages),
-      obstacle_memory_(options.obstacle_memory) {
+      obstacle_memory_(options.obstacle_memory),
+      seen_walls_(options.frontiers.seen_wall_range, options.frontiers.seen_wall_margin) {
   blacklist_.radius = options.blacklist_radius;
 }
 
@@ -61,6 +62,7 @@ void ExplorationPolicy::setUnusableMap(const std::string& reason) {
 
 void ExplorationPolicy::addScan(const std::vector<common::Point2>& points, const common::Pose2& pose, double time) {
   obstacle_memory_.add(points, pose, time);
+  seen_walls_.addScan(points, pose, time);
 }
 
 void ExplorationPolicy::hold(double time) { follower_.hold(time); }
@@ -137,11 +139,12 @@ ExplorationPolicy::CostMap ExplorationPolicy::computeCostMap(const ExplorationPo
                                                              const Blacklist& blacklist,
                                                              const std::vector<common::Point2>& blocked_points,
                                                              const common::OccupancyGrid& map,
+                                                             const cv::Mat1b& seen_walls,
                                                              const common::Point2& robot, bool new_map) {
   CostMap result{GridPlanner(options.planner), FrontierMap(), false, new_map};
   result.planner.setBlockedPoints(blocked_points, options.passages.radius);
   result.planner.setMap(map);
-  result.frontiers = findFrontiers(result.planner.map(), options.frontiers);
+  result.frontiers = findFrontiers(result.planner.map(), options.frontiers, seen_walls);
   const cv::Mat1b targets = goalCandidates(result.frontiers, result.planner, blacklist, options.frontiers, robot,
                                            options.planner.start_escape_radius);
   result.start_reachable = result.planner.computeCostsFrom(robot, targets, options.goal_hysteresis);
@@ -161,14 +164,21 @@ void ExplorationPolicy::plan(const common::Pose2& pose, double time, Exploration
   }
   const bool new_map = pending == PendingMap::kUsable;
   const common::OccupancyGrid map = new_map ? next_map_ : planner_.map();
-  if (new_map) next_map_ = common::OccupancyGrid();
+  if (new_map) {
+    next_map_ = common::OccupancyGrid();
+    seen_walls_.setGrid(map);
+    map_time_ = time;
+  }
+  // Walls the laser saw long enough before this map that the map would show them.
+  const cv::Mat1b seen_walls = seen_walls_.seenBy(map_time_ - options_.frontiers.seen_wall_delay);
   const common::Point2 robot(pose.x, pose.y);
   if (!options_.background_planning) {
-    choose(computeCostMap(options_, blacklist_, passages_.blockedPoints(), map, robot, new_map), pose, time, step);
+    choose(computeCostMap(options_, blacklist_, passages_.blockedPoints(), map, seen_walls, robot, new_map), pose,
+           time, step);
     return;
   }
   background_plan_ = std::async(std::launch::async, &ExplorationPolicy::computeCostMap, options_, blacklist_,
-                                passages_.blockedPoints(), map, robot, new_map);
+                                passages_.blockedPoints(), map, seen_walls, robot, new_map);
 }
 
 void ExplorationPolicy::choose(CostMap cost_map, const common::Pose2& pose, double time, ExplorationStep* step) {

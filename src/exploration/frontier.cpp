@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include <opencv2/imgproc.hpp>
@@ -10,7 +11,8 @@
 
 namespace hidden_rooms::exploration {
 
-FrontierMap findFrontiers(const common::OccupancyGrid& map, const FrontierOptions& options) {
+FrontierMap findFrontiers(const common::OccupancyGrid& map, const FrontierOptions& options,
+                          const cv::Mat1b& seen_walls) {
   FrontierMap result;
   if (map.empty()) return result;
   const int rows = map.height(), cols = map.width();
@@ -32,7 +34,7 @@ FrontierMap findFrontiers(const common::OccupancyGrid& map, const FrontierOption
   for (int row = 0; row < rows; ++row)
     for (int col = 0; col < cols; ++col) {
       const int value = map.cells(row, col);
-      if (value < 0 || value > options.free_threshold) continue;
+      if (value < 0 || value > options.free_threshold || (!seen_walls.empty() && seen_walls(row, col))) continue;
       if (significant_unknown(col + 1, row) || significant_unknown(col - 1, row) ||
           significant_unknown(col, row + 1) || significant_unknown(col, row - 1))
         frontier_cells(row, col) = 255;
@@ -62,6 +64,47 @@ FrontierMap findFrontiers(const common::OccupancyGrid& map, const FrontierOption
     }
   for (Frontier& frontier : result.frontiers) frontier.centroid /= static_cast<double>(frontier.cells.size());
   return result;
+}
+
+void SeenWalls::setGrid(const common::OccupancyGrid& map) {
+  const bool same_grid = !first_time_.empty() && map.resolution == grid_.resolution &&
+                         map.origin == grid_.origin && map.cells.size() == grid_.cells.size();
+  if (!same_grid) {
+    cv::Mat1d moved(map.height(), map.width(), std::numeric_limits<double>::infinity());
+    if (!first_time_.empty() && map.resolution == grid_.resolution) {
+      for (int row = 0; row < map.height(); ++row)
+        for (int col = 0; col < map.width(); ++col) {
+          int old_col = 0, old_row = 0;
+          if (grid_.cellOf(map.cellCentre(col, row), &old_col, &old_row))
+            moved(row, col) = first_time_(old_row, old_col);
+        }
+    }
+    first_time_ = moved;
+  }
+  grid_ = map;
+}
+
+void SeenWalls::addScan(const std::vector<common::Point2>& points, const common::Pose2& pose, double time) {
+  if (first_time_.empty() || range_ <= 0.0) return;
+  const common::Point2 origin(pose.x, pose.y);
+  const double step = 0.5 * grid_.resolution;
+  for (const common::Point2& point : points) {
+    const common::Point2 ray = common::transformPoint(pose, point) - origin;
+    const double length = ray.norm();
+    if (!(length > 0.0 && length <= range_)) continue;
+    const common::Point2 direction = ray / length;
+    for (double along = length; along <= length + margin_; along += step) {
+      int col = 0, row = 0;
+      if (!grid_.cellOf(origin + along * direction, &col, &row)) continue;
+      double& first = first_time_(row, col);
+      first = std::min(first, time);
+    }
+  }
+}
+
+cv::Mat1b SeenWalls::seenBy(double time) const {
+  if (first_time_.empty()) return cv::Mat1b();
+  return first_time_ <= time;
 }
 
 bool Blacklist::contains(const common::Point2& point) const {
@@ -109,6 +152,13 @@ const common::OptionTable<FrontierOptions>& frontierOptionTable() {
        common::atLeast(1)},
       {"goal_reach", &O::goal_reach, "metres: a goal lies within this of a frontier cell", common::atLeast(0)},
       {"min_goal_distance", &O::min_goal_distance, "metres: and at least this far from the robot",
+       common::atLeast(0)},
+      {"seen_wall_range", &O::seen_wall_range,
+       "metres: a free cell at (or seen_wall_margin behind) the end of a beam at most this long, next to "
+       "unknown space in a map seen_wall_delay later, is in a wall, no frontier; 0 = off",
+       common::atLeast(0)},
+      {"seen_wall_margin", &O::seen_wall_margin, "metres behind the beam's end", common::atLeast(0)},
+      {"seen_wall_delay", &O::seen_wall_delay, "seconds between the scan and the map that judges it",
        common::atLeast(0)},
   };
   return table;

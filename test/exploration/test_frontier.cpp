@@ -87,6 +87,44 @@ TEST(Frontier, UncertainCellsCountAsUnknown) {
   for (const cv::Point& cell : frontiers.frontiers[0].cells) EXPECT_EQ(cell.x, 19);
 }
 
+TEST(Frontier, FreeCellsAtAWallTheLaserSeesAreNoFrontier) {
+  // A free room (cols 5..24, rows 2..17) in unknown space. Its right wall (col 25) is drawn with holes in rows
+  // 5..12, as passes with slightly different pose estimates leave it; its left wall has a real opening (rows
+  // 7..12). The robot at (1.5, 1.0) sees the right wall at x = 2.55 behind the holes; its beams through the
+  // opening end 4.5 m away (beyond seen_wall_range).
+  common::OccupancyGrid grid = unknownGrid(40, 20);
+  grid.cells(cv::Rect(4, 1, 22, 18)).setTo(common::OccupancyGrid::kOccupied);
+  grid.cells(cv::Rect(5, 2, 20, 16)).setTo(common::OccupancyGrid::kFree);
+  grid.cells(cv::Rect(25, 5, 1, 8)).setTo(common::OccupancyGrid::kFree);  // the holes
+  grid.cells(cv::Rect(4, 7, 1, 6)).setTo(common::OccupancyGrid::kFree);   // the opening
+  FrontierOptions options;
+  options.min_frontier_cells = 4;
+  const common::Pose2 robot{1.5, 1.0, 0.0};
+  std::vector<common::Point2> points;
+  for (double y = 0.25; y <= 1.75; y += 0.02) points.emplace_back(1.05, y - robot.y);  // the right wall
+  for (double y = 0.75; y <= 1.25; y += 0.02) points.emplace_back(-4.5, y - robot.y);  // through the opening
+
+  SeenWalls seen(options.seen_wall_range, options.seen_wall_margin);
+  seen.addScan(points, robot, 0.5);  // before any map: not kept
+  EXPECT_TRUE(seen.seenBy(1.0).empty());
+  seen.setGrid(grid);
+  seen.addScan(points, robot, 1.0);
+  EXPECT_EQ(findFrontiers(grid, options, seen.seenBy(0.9)).frontiers.size(), 2u);  // the scan came later
+  const FrontierMap frontiers = findFrontiers(grid, options, seen.seenBy(1.0));
+  ASSERT_EQ(frontiers.frontiers.size(), 1u);
+  for (const cv::Point& cell : frontiers.frontiers[0].cells) EXPECT_EQ(cell.x, 4);  // the opening is left
+
+  // The map grows by 1 m to the left: the seen cells stay where they are in the map frame.
+  common::OccupancyGrid grown = unknownGrid(50, 20);
+  grown.origin = common::Point2(-1.0, 0.0);
+  grid.cells.copyTo(grown.cells(cv::Rect(10, 0, 40, 20)));
+  seen.setGrid(grown);
+  const cv::Mat1b moved = seen.seenBy(1.0);
+  EXPECT_EQ(cv::countNonZero(moved), cv::countNonZero(seen.seenBy(1.0)));
+  EXPECT_EQ(findFrontiers(grown, options, moved).frontiers.size(), 1u);
+  EXPECT_EQ(cv::countNonZero(moved(cv::Rect(35, 5, 1, 8))), 8);  // col 25 of the first grid
+}
+
 // A 10 m x 4 m free corridor (0.1 m cells) closed by walls, with unknown strips at both ends behind gaps:
 // frontier at the left end (x ~ 0.2) and at the right end (x ~ 9.8).
 common::OccupancyGrid corridorWithTwoEnds() {

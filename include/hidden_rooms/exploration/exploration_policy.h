@@ -130,7 +130,7 @@ class ExplorationPolicy {
   // and the kept one are the same as with costs everywhere.
   static CostMap computeCostMap(const ExplorationPolicyOptions& options, const Blacklist& blacklist,
                                 const std::vector<common::Point2>& blocked_points, const common::OccupancyGrid& map,
-                                const common::Point2& robot, bool new_map);
+                                const cv::Mat1b& seen_walls, const common::Point2& robot, bool new_map);
   // Starts a plan from `pose` (in the background or in place): takes the pending map, if any.
   void plan(const common::Pose2& pose, double time, ExplorationStep* step);
   // Takes a finished cost map, chooses a goal and a path from `pose`, releasing blocked goals when none is left;
@@ -145,6 +145,8 @@ class ExplorationPolicy {
   Blacklist blacklist_;
   BlockedPassages passages_;
   ObstacleMemory obstacle_memory_;
+  SeenWalls seen_walls_;
+  double map_time_ = 0.0;  // time of the update that took the last usable map
   PendingMap pending_map_ = PendingMap::kNone;
   common::OccupancyGrid next_map_;
   std::string unusable_reason_;

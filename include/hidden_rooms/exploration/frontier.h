@@ -20,6 +20,13 @@ struct FrontierOptions {
   int min_unknown_cells = 20;    // unknown areas (4-connected) with fewer cells are specks, not frontier material
   double goal_reach = 0.6;       // metres: a goal is a traversable cell within this distance of the frontier ...
   double min_goal_distance = 0.5;  // ... and at least this far from the robot (a goal at the robot teaches nothing)
+  // A free cell where a laser beam at most seen_wall_range long ended, or up to seen_wall_margin behind that end,
+  // lies in a wall the laser sees; when a map made seen_wall_delay seconds later still shows it next to unknown
+  // space, that space is the wall's inside (a wall the map draws a few cm off, with holes), not unexplored: no
+  // frontier cell.
+  double seen_wall_range = 2.0;   // metres (0 = off)
+  double seen_wall_margin = 0.15;  // metres behind the beam's end
+  double seen_wall_delay = 4.0;   // seconds: more than the mapper's lag (scan insertion, map publication)
 };
 
 // A frontier: a connected group of free cells that border unknown space.
@@ -35,9 +42,31 @@ struct FrontierMap {
 };
 
 // Frontier cells are free cells with a 4-neighbour that is unknown (-1, or neither free nor occupied, or outside
-// the grid) and belongs to an unknown area of at least min_unknown_cells; they are grouped 8-connected (OpenCV connected components) and
-// groups under min_frontier_cells dropped. An empty map has none.
-FrontierMap findFrontiers(const common::OccupancyGrid& map, const FrontierOptions& options = FrontierOptions());
+// the grid) and belongs to an unknown area of at least min_unknown_cells, and that are not set in `seen_walls`
+// (empty, or of the map's size); they are grouped 8-connected (OpenCV connected components) and groups under
+// min_frontier_cells dropped. An empty map has none.
+FrontierMap findFrontiers(const common::OccupancyGrid& map, const FrontierOptions& options = FrontierOptions(),
+                          const cv::Mat1b& seen_walls = cv::Mat1b());
+
+// Where the laser has seen walls from close by: per cell, the first time a beam at most `range` long ended in the
+// cell or up to `margin` before it (the cell lies that far behind the beam's end). The cells are those of the last
+// map given to setGrid (kept across maps whose grid grows or moves; a new resolution starts afresh); scans before
+// the first map are not kept.
+class SeenWalls {
+ public:
+  SeenWalls(double range, double margin) : range_(range), margin_(margin) {}
+  void setGrid(const common::OccupancyGrid& map);
+  // The returns (base_link) of a scan taken with the robot at `pose` (map frame) at `time`; beams start at the
+  // robot's centre.
+  void addScan(const std::vector<common::Point2>& points, const common::Pose2& pose, double time);
+  // 255 on the cells first seen as wall no later than `time` (the last setGrid's size; empty before it).
+  cv::Mat1b seenBy(double time) const;
+
+ private:
+  double range_, margin_;
+  common::OccupancyGrid grid_;  // the last map (for its grid)
+  cv::Mat1d first_time_;        // per cell of grid_; +infinity: never
+};
 
 // How a goal ended, for the blacklist.
 enum class GoalOutcome {
