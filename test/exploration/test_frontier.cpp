@@ -115,12 +115,14 @@ TEST(Frontier, FreeCellsAtAWallTheLaserSeesAreNoFrontier) {
   for (const cv::Point& cell : frontiers.frontiers[0].cells) EXPECT_EQ(cell.x, 4);  // the opening is left
 
   // The map grows by 1 m to the left: the seen cells stay where they are in the map frame.
+  const int seen_cells = cv::countNonZero(seen.seenBy(1.0));
+  EXPECT_GT(seen_cells, 0);
   common::OccupancyGrid grown = unknownGrid(50, 20);
   grown.origin = common::Point2(-1.0, 0.0);
   grid.cells.copyTo(grown.cells(cv::Rect(10, 0, 40, 20)));
   seen.setGrid(grown);
   const cv::Mat1b moved = seen.seenBy(1.0);
-  EXPECT_EQ(cv::countNonZero(moved), cv::countNonZero(seen.seenBy(1.0)));
+  EXPECT_EQ(cv::countNonZero(moved), seen_cells);
   EXPECT_EQ(findFrontiers(grown, options, moved).frontiers.size(), 1u);
   EXPECT_EQ(cv::countNonZero(moved(cv::Rect(35, 5, 1, 8))), 8);  // col 25 of the first grid
 }
