@@ -189,4 +189,18 @@ cv::Mat1b reachableFreeArea(const common::OccupancyGrid& rendered, const common:
   return body & free_cells;
 }
 
+cv::Mat1b reachableFreeArea(const common::OccupancyGrid& rendered, const common::OccupancyGrid& fine,
+                            const common::Point2& start, double clearance) {
+  const cv::Mat1b fine_reached = reachableFreeArea(fine, start, clearance);
+  cv::Mat1b reached = cv::Mat1b::zeros(rendered.height(), rendered.width());
+  for (int row = 0; row < rendered.height(); ++row)
+    for (int col = 0; col < rendered.width(); ++col) {
+      int fine_col = 0, fine_row = 0;
+      if (rendered.cells(row, col) == common::OccupancyGrid::kFree &&
+          fine.cellOf(rendered.cellCentre(col, row), &fine_col, &fine_row) && fine_reached(fine_row, fine_col))
+        reached(row, col) = 255;
+    }
+  return reached;
+}
+
 }  // namespace hidden_rooms::evaluation

@@ -14,6 +14,7 @@
 #include "hidden_rooms/common/command_line.h"
 #include "hidden_rooms/common/file_io.h"
 #include "hidden_rooms/common/input_error.h"
+#include "hidden_rooms/common/input_limits.h"
 #include "hidden_rooms/common/label_image.h"
 #include "hidden_rooms/common/range_scan.h"
 #include "hidden_rooms/evaluation/door_translation.h"
@@ -36,10 +37,18 @@ cv::Mat1f distanceToOccupied(const common::OccupancyGrid& map) {
   return distance * map.resolution;
 }
 
+// `wanted`, or the finest resolution at which the world's rendering stays within the map size limit when that is
+// coarser.
+double reachResolution(const world::Environment& environment, const world::RenderOptions& options, double wanted) {
+  const auto [low, high] = environment.bounds();
+  const double area = (high.x() - low.x() + 2.0 * options.margin + 1.0) * (high.y() - low.y() + 2.0 * options.margin + 1.0);
+  return std::max(wanted, std::sqrt(area / common::kMaxMapCells));
+}
+
 int run(int argc, char** argv) {
   po::options_description options("Options");
   std::string environment_path, closed_spec, truth_path, estimate_path, map_path, out_dir;
-  double door_width = 0.9, robot_radius = 0.25;
+  double door_width = 0.9, robot_radius = 0.25, reach_resolution = 0.02;
   world::RenderOptions render_options;
   options.add_options()
       ("environment", po::value(&environment_path)->required(), "environment XML the robot explored")
@@ -54,6 +63,9 @@ int run(int argc, char** argv) {
       ("robot-radius", po::value(&robot_radius)->default_value(0.25),
        "half the robot's width, metres: coverage counts the free area a body this wide can reach (0: every free "
        "cell connected to the start)")
+      ("reach-resolution", po::value(&reach_resolution)->default_value(0.02),
+       "metres per cell of the world's rendering on which the area the robot's body reaches is decided (the "
+       "coverage is scored on the map's 5 cm grid; coarser when the world is too large for this)")
       ("wall-thickness", po::value<double>(), "wall thickness as simulated, metres (default: the world's)");
   po::positional_options_description positional;
   po::variables_map values;
@@ -71,6 +83,7 @@ int run(int argc, char** argv) {
     return common::kExitOk;
   if (!(door_width > 0.0)) throw common::InputError("--door-width", "must be positive");
   if (!(robot_radius >= 0.0)) throw common::InputError("--robot-radius", "must be zero or positive");
+  if (!(reach_resolution > 0.0)) throw common::InputError("--reach-resolution", "must be positive");
   if (values.count("wall-thickness")) render_options.wall_thickness = values["wall-thickness"].as<double>();
   render_options.door_width = door_width;
 
@@ -110,8 +123,11 @@ int run(int argc, char** argv) {
   // Scoring: the world placed in the map frame by the least-squares fit of the two trajectories.
   const common::Pose2 world_from_map = evaluation::fitWorldFromMap(truth.poses, estimate.poses);
   const common::Pose2 start = truth.poses.front().pose;
+  world::RenderOptions fine_options = render_options;
+  fine_options.resolution = std::min(render_options.resolution, reachResolution(environment, render_options, reach_resolution));
+  const world::RenderedEnvironment fine = world::renderEnvironment(environment, closed, fine_options);
   const cv::Mat1b reachable =
-      evaluation::reachableFreeArea(rendered.map, common::Point2(start.x, start.y), robot_radius);
+      evaluation::reachableFreeArea(rendered.map, fine.map, common::Point2(start.x, start.y), robot_radius);
   const evaluation::MapQuality quality = evaluation::evaluateMap(map, world_from_map, rendered.map, reachable);
   const evaluation::MapQuality all_free = evaluation::evaluateMap(
       map, world_from_map, rendered.map, evaluation::reachableFreeArea(rendered.map, common::Point2(start.x, start.y)));
@@ -132,6 +148,7 @@ int run(int argc, char** argv) {
          << "coverage_all_free: " << coverageOf(all_free)
          << "  # mapped free / true free cells 4-connected to the start (also behind gaps narrower than the robot)\n"
          << "robot_radius: " << robot_radius << "\n"
+         << "reach_resolution: " << fine_options.resolution << "  # metres per cell on which the body's reach is decided\n"
          << "free_iou: " << all_free.free_iou << "\n"
          << "walls_within_2_cells: " << all_free.walls_within_2_cells << "\n"
          << "path_length: " << pathLength(truth.poses) << "  # metres, true trajectory\n"

@@ -195,6 +195,44 @@ TEST(DoorTranslation, ReachableAreaWithAClearanceStopsAtGapsNarrowerThanTheRobot
   EXPECT_THROW(reachableFreeArea(grid, start, -0.1), common::InputError);
 }
 
+// Two 2 m rooms side by side, with a wall 0.1 m thick at x = 2 m and a gap of `gap` metres in it centred at
+// y = 1 m, drawn at `resolution` (a cell is a wall when its centre is in one, as the renderer draws).
+common::OccupancyGrid twoRoomsWithAGap(double gap, double resolution) {
+  common::OccupancyGrid grid;
+  grid.resolution = resolution;
+  const int cols = static_cast<int>(std::lround(4.2 / resolution)), rows = static_cast<int>(std::lround(2.2 / resolution));
+  grid.cells = cv::Mat_<int8_t>(rows, cols, common::OccupancyGrid::kFree);
+  for (int row = 0; row < rows; ++row)
+    for (int col = 0; col < cols; ++col) {
+      const common::Point2 centre = grid.cellCentre(col, row);
+      const bool border = centre.x() < 0.1 || centre.x() > 4.1 || centre.y() < 0.1 || centre.y() > 2.1;
+      const bool wall = std::abs(centre.x() - 2.1) < 0.05 && std::abs(centre.y() - 1.1) > 0.5 * gap;
+      if (border || wall) grid.cells(row, col) = common::OccupancyGrid::kOccupied;
+    }
+  return grid;
+}
+
+// A door 0.47 m wide, drawn 0.50 m on a 5 cm grid, lets a body 0.5 m wide through there; decided on a 1 cm
+// rendering it does not. A 0.56 m door passes on both.
+TEST(DoorTranslation, ReachDecidedOnAFinerRenderingStopsAtADoorJustNarrowerThanTheBody) {
+  const common::Point2 start(1.0, 1.0);
+  const auto reaches_the_far_room = [](const cv::Mat1b& reached, const common::OccupancyGrid& grid) {
+    int col = 0, row = 0;
+    EXPECT_TRUE(grid.cellOf(common::Point2(3.2, 1.1), &col, &row));
+    return reached(row, col) == 255;
+  };
+  const common::OccupancyGrid narrow = twoRoomsWithAGap(0.47, 0.05), narrow_fine = twoRoomsWithAGap(0.47, 0.01);
+  EXPECT_TRUE(reaches_the_far_room(reachableFreeArea(narrow, start, 0.25), narrow));
+  const cv::Mat1b decided_fine = reachableFreeArea(narrow, narrow_fine, start, 0.25);
+  EXPECT_FALSE(reaches_the_far_room(decided_fine, narrow));
+  EXPECT_EQ(decided_fine.size(), narrow.cells.size());
+  EXPECT_GT(cv::countNonZero(decided_fine), 0.8 * 1.9 * 1.9 / (0.05 * 0.05));  // the start's room
+  const common::OccupancyGrid wide = twoRoomsWithAGap(0.56, 0.05), wide_fine = twoRoomsWithAGap(0.56, 0.01);
+  EXPECT_TRUE(reaches_the_far_room(reachableFreeArea(wide, wide_fine, start, 0.25), wide));
+  // Only free cells of the coarse grid count.
+  EXPECT_EQ(cv::countNonZero(decided_fine & (narrow.cells != common::OccupancyGrid::kFree)), 0);
+}
+
 TEST(DoorTranslation, MovesTheTrueRoomsIntoTheMapGrid) {
   const world::Environment environment =
       world::loadEnvironment(std::string(HIDDEN_ROOMS_SOURCE_DIR) + "/worlds/small_1.xml");

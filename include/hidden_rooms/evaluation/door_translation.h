@@ -72,4 +72,10 @@ cv::Mat1w trueRoomsInMap(const world::Environment& environment, const std::vecto
 // (with a clearance: no centre position within 1 m of it).
 cv::Mat1b reachableFreeArea(const common::OccupancyGrid& rendered, const common::Point2& start, double clearance = 0.0);
 
+// The same for the cells of `rendered`, decided on `fine`, the same world rendered at a finer resolution: a cell
+// counts when the fine cell at its centre is reached. A map's 5 cm grid cannot tell a door a few centimetres
+// narrower than the robot from one it passes (on it a 0.48 m door lets a 0.50 m body through); a 1 or 2 cm one can.
+cv::Mat1b reachableFreeArea(const common::OccupancyGrid& rendered, const common::OccupancyGrid& fine,
+                            const common::Point2& start, double clearance);
+
 }  // namespace hidden_rooms::evaluation
