@@ -116,13 +116,27 @@ std::vector<common::Point2> ObstacleMemory::points(const common::Pose2& pose) co
 
 namespace {
 
-// Free distance beyond the footprint's front (`direction` +1) or rear (-1) within its lane. Points beside the
-// footprint in the lane's side margins do not count (driving straight does not bring them closer); points inside
-// the footprint's half on that side give 0.
+// The margin kept beside the footprint when moving: side_margin, or 70% of the present gap (the distance from the
+// footprint to the nearest point) when something is already closer. The robot may go on through a passage as tight
+// as where it stands, but not into a tighter one; with the full margin it could not move at all in a tight door.
+double movingMargin(const std::vector<common::Point2>& obstacles, const PathFollowerOptions& options) {
+  constexpr double kShareOfPresentGap = 0.7;
+  const double half_length = 0.5 * options.footprint_length, half_width = 0.5 * options.footprint_width;
+  double gap = kInfinity;
+  for (const common::Point2& point : obstacles)
+    if (point.allFinite())
+      gap = std::min(gap, std::hypot(std::max(0.0, std::abs(point.x()) - half_length),
+                                     std::max(0.0, std::abs(point.y()) - half_width)));
+  return std::min(options.side_margin, kShareOfPresentGap * gap);
+}
+
+// Free distance beyond the footprint's front (`direction` +1) or rear (-1) within its lane (the footprint's width
+// plus movingMargin each side). Points beside the footprint in the lane's side margins do not count (driving
+// straight does not bring them closer); points inside the footprint's half on that side give 0.
 double laneClearance(const std::vector<common::Point2>& obstacles, const PathFollowerOptions& options,
                      double direction) {
   const double half_length = 0.5 * options.footprint_length, half_width = 0.5 * options.footprint_width;
-  const double half_lane = half_width + options.side_margin;
+  const double half_lane = half_width + movingMargin(obstacles, options);
   double clearance = kInfinity;
   for (const common::Point2& point : obstacles) {
     const double along = direction * point.x();
@@ -144,6 +158,12 @@ double frontClearance(const std::vector<common::Point2>& obstacles, const PathFo
 
 double rearClearance(const std::vector<common::Point2>& obstacles, const PathFollowerOptions& options) {
   return laneClearance(obstacles, options, -1.0);
+}
+
+double PathFollower::footprintClearance(const std::vector<common::Point2>& obstacles) const {
+  PathFollowerOptions no_margin = options_;
+  no_margin.side_margin = 0.0;
+  return laneClearance(obstacles, no_margin, 1.0);
 }
 
 PathFollower::PathFollower(const PathFollowerOptions& options) : options_(options) { validate(options_); }
@@ -303,13 +323,7 @@ bool PathFollower::arcHitsObstacle(const std::vector<common::Point2>& obstacles,
   std::vector<common::Point2> near;
   for (const common::Point2& point : obstacles)
     if (point.allFinite() && point.norm() <= reach) near.push_back(point);
-  // Already within the margin of something (a tight door): the arc may not come closer than 70% of the present
-  // gap, or nothing could move.
-  double gap = std::numeric_limits<double>::infinity();
-  for (const common::Point2& point : near)
-    gap = std::min(gap, std::hypot(std::max(0.0, std::abs(point.x()) - half_length),
-                                   std::max(0.0, std::abs(point.y()) - half_width)));
-  const double margin = std::min(options_.side_margin, 0.7 * gap);
+  const double margin = movingMargin(near, options_);
   constexpr double kStep = 0.1;  // seconds between checked poses
   for (double t = std::min(kStep, horizon); t <= horizon + 1e-9; t += kStep) {
     // Unicycle pose after t seconds from the origin.
@@ -442,7 +456,15 @@ FollowerStep PathFollower::follow(const common::Pose2& pose, const std::vector<c
   // the frame, where the laser does not look.
   if (inDoorway(obstacles)) angular = std::clamp(angular, -options_.doorway_angular_velocity, options_.doorway_angular_velocity);
   if (linear <= 1e-3) {
-    // Blocked ahead: still turn towards the path (the stall watch starts a recovery if nothing changes).
+    // Blocked ahead. When only the lane's side margins hold what stops it (a wall's end beside its way, the
+    // footprint's own width clear), creep straight on: the robot passes the wall's end at the side distance it
+    // has now, and then turns round it. Otherwise turn towards the path (the stall watch starts a recovery if
+    // nothing changes).
+    if (footprintClearance(obstacles) > options_.stop_distance) {
+      step.command.linear = options_.creep_velocity;
+      step.command.angular = 0.0;
+      return step;
+    }
     angular = std::clamp(options_.heading_gain * heading_error, -options_.max_angular_velocity,
                          options_.max_angular_velocity);
     linear = 0.0;

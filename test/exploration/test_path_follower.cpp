@@ -162,6 +162,31 @@ TEST(PathFollower, SlowsDownAndStopsInFrontOfAnObstacle) {
   EXPECT_NEAR(step.command.linear, options.max_linear_velocity, 1e-9);
 }
 
+TEST(PathFollower, CreepsStraightPastAWallsEndInTheLanesMargin) {
+  PathFollowerOptions options;
+  const double half_length = 0.5 * options.footprint_length, half_width = 0.5 * options.footprint_width;
+  // A wall's end just ahead of the front, in the right side margin of the lane only (0.03 m beside the footprint's
+  // width), and the path bending right round it: the robot neither stops nor turns into it, it creeps straight on.
+  const std::vector<common::Point2> wall_end{{half_length + 0.05, -half_width - 0.03},
+                                             {half_length + 0.10, -half_width - 0.03},
+                                             {half_length + 0.15, -half_width - 0.03}};
+  std::vector<common::Point2> bending;  // straight for 0.3 m, then 30 degrees to the right
+  for (double x = 0.0; x < 0.3; x += 0.05) bending.emplace_back(x, 0.0);
+  for (double t = 0.0; t <= 3.0; t += 0.05) bending.emplace_back(0.3 + t * std::cos(M_PI / 6), -t * std::sin(M_PI / 6));
+  PathFollower follower(options);
+  follower.setPath(bending, 0.0);
+  FollowerStep step = follower.update(common::Pose2{}, wall_end, 0.1);
+  EXPECT_NEAR(step.front_clearance, 0.05, 1e-9);
+  EXPECT_NEAR(step.command.linear, options.creep_velocity, 1e-9);
+  EXPECT_EQ(step.command.angular, 0.0);
+  // Within the footprint's width less than stop_distance ahead as well: it stops and turns towards the path.
+  std::vector<common::Point2> blocked = wall_end;
+  blocked.emplace_back(half_length + 0.5 * options.stop_distance, 0.0);
+  step = follower.update(common::Pose2{}, blocked, 0.2);
+  EXPECT_EQ(step.command.linear, 0.0);
+  EXPECT_LT(step.command.angular, 0.0);
+}
+
 TEST(PathFollower, IgnoresNonFiniteObstaclePoints) {
   PathFollower follower;
   follower.setPath(straightPath(5.0), 0.0);
@@ -395,15 +420,32 @@ TEST(PathFollower, WallsBesideTheFootprintLeaveItsLaneOpen) {
   }
   EXPECT_EQ(frontClearance(tunnel, options), std::numeric_limits<double>::infinity());
   EXPECT_EQ(rearClearance(tunnel, options), std::numeric_limits<double>::infinity());
-  // The walls go on ahead within the side margin (the margin is kept ahead): the lane ends 0.4 m ahead of the
-  // front; behind it stays open.
+  // The walls go on ahead at the same 0.03 m: a passage as tight as where the robot stands, so the lane (which
+  // keeps 70% of the present gap, 0.021 m, beside the footprint) stays open.
   tunnel.emplace_back(half_length + 0.4, half_width + 0.03);
-  EXPECT_NEAR(frontClearance(tunnel, options), 0.4, 1e-9);
+  EXPECT_EQ(frontClearance(tunnel, options), std::numeric_limits<double>::infinity());
+  // A tighter one ahead (0.015 m beside the footprint's side) ends the lane there; behind it stays open.
+  tunnel.emplace_back(half_length + 0.5, half_width + 0.015);
+  EXPECT_NEAR(frontClearance(tunnel, options), 0.5, 1e-9);
   EXPECT_EQ(rearClearance(tunnel, options), std::numeric_limits<double>::infinity());
-  // A point inside the footprint's rear half (a wall it touches): no room behind, ahead unchanged.
+  // A point inside the footprint's rear half (a wall it touches): no room behind; ahead the lane keeps no margin
+  // now (the present gap is 0), and only what lies within the footprint's width would end it.
   tunnel.emplace_back(-0.2, half_width - 0.01);
   EXPECT_EQ(rearClearance(tunnel, options), 0.0);
-  EXPECT_NEAR(frontClearance(tunnel, options), 0.4, 1e-9);
+  EXPECT_EQ(frontClearance(tunnel, options), std::numeric_limits<double>::infinity());
+  tunnel.emplace_back(half_length + 0.6, half_width - 0.01);
+  EXPECT_NEAR(frontClearance(tunnel, options), 0.6, 1e-9);
+}
+
+TEST(PathFollower, TheLaneKeepsTheFullSideMarginInTheOpen) {
+  PathFollowerOptions options;
+  const double half_length = 0.5 * options.footprint_length, half_width = 0.5 * options.footprint_width;
+  // Nothing beside the footprint: a post 0.4 m ahead, 0.03 m beside the footprint's side line, is in the lane.
+  const std::vector<common::Point2> post{{half_length + 0.4, half_width + 0.03}};
+  EXPECT_NEAR(frontClearance(post, options), 0.4, 1e-9);
+  // Without a side margin it is not.
+  options.side_margin = 0.0;
+  EXPECT_EQ(frontClearance(post, options), std::numeric_limits<double>::infinity());
 }
 
 TEST(PathFollower, ObstacleMemoryKeepsRecentPointsInTheRobotFrame) {

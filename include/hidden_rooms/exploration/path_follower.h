@@ -17,20 +17,24 @@ struct PathFollowerOptions {
   double goal_tolerance = 0.3;         // metres: the goal is reached within this distance of the path's end
   double rotate_in_place_angle = 0.8;  // rad: a larger heading error to the pursued point turns in place
   double heading_gain = 2.0;           // rad/s per rad of heading error when turning in place
-  // Robot box (metres) centred on base_link, and the free margin kept beside it.
+  // Robot box (metres) centred on base_link, and the free margin kept beside it when moving: side_margin, or 70%
+  // of the present gap (footprint to nearest laser point) when something is already closer, so the robot may go
+  // on through a passage as tight as where it stands but not into a tighter one.
   double footprint_length = 0.626;
   double footprint_width = 0.505;
   double side_margin = 0.05;
-  double stop_distance = 0.12;         // metres: with less free space ahead of the front the robot does not go on
+  // Metres: with less free space ahead of the front the robot does not go on. When what stops it lies in the lane's
+  // side margins only (a wall's end beside its way), it creeps straight on at creep_velocity while the footprint's
+  // own width has more than this free ahead; else it turns towards the path.
+  double stop_distance = 0.12;
   double deceleration = 0.8;           // m/s^2: speed ahead is capped at sqrt(2 * deceleration * free space)
   // Turning in place with laser points inside the circle the footprint sweeps (plus side_margin) on its front or
   // rear half only, the robot also moves away from them at this speed (m/s); with points on both halves (a
   // doorway) it first creeps straight ahead; either only when the lane that way is free.
   double creep_velocity = 0.1;
-  // Seconds of the commanded arc checked against the laser points (footprint + side_margin, or 70% of the present
-  // gap when that is smaller; up to the path's end);
-  // when it would hit, the nearest turn rate with a clear arc is taken (then at half the speed); when there is
-  // none the command stays (the front speed cap stops the robot). 0 = no check.
+  // Seconds of the commanded arc checked against the laser points (footprint + the moving margin above, up to the
+  // path's end); when it would hit, the nearest turn rate with a clear arc is taken (then at half the speed); when
+  // there is none the command stays (the front speed cap stops the robot). 0 = no check.
   double arc_horizon = 1.0;
   // In a doorway (laser points beside both sides of the footprint, within doorway_distance of them) the turn
   // rate is capped at doorway_angular_velocity (rad/s): the rear, which the laser does not see, would swing into
@@ -98,9 +102,10 @@ class ObstacleMemory {
   std::vector<Scan> scans_;
 };
 
-// Free space (metres) ahead of the robot's front edge within its lane (footprint width plus side_margin on both
-// sides), from obstacle points in base_link; +infinity when the lane is empty. Points inside the footprint's front
-// half count as 0; points beside it (in the side margins) do not count: driving straight does not come closer.
+// Free space (metres) ahead of the robot's front edge within its lane (footprint width plus the moving margin,
+// side_margin or 70% of the present gap, on both sides), from obstacle points in base_link; +infinity when the
+// lane is empty. Points inside the footprint's front half count as 0; points beside it (in the side margins) do
+// not count: driving straight does not come closer.
 double frontClearance(const std::vector<common::Point2>& obstacles, const PathFollowerOptions& options);
 // The same behind the rear edge (the laser may not see there: then +infinity).
 double rearClearance(const std::vector<common::Point2>& obstacles, const PathFollowerOptions& options);
@@ -135,14 +140,14 @@ class PathFollower {
 
  private:
   FollowerStep follow(const common::Pose2& pose, const std::vector<common::Point2>& obstacles, double clearance);
-  // True when the footprint (plus side_margin, or 70% of the present gap when something is already closer) moving
-  // forward on the
-  // arc (linear > 0, angular) from base_link meets an obstacle point within arc_horizon seconds and max_distance
-  // metres.
+  // True when the footprint (plus the moving margin) moving forward on the arc (linear > 0, angular) from
+  // base_link meets an obstacle point within arc_horizon seconds and max_distance metres.
   bool arcHitsObstacle(const std::vector<common::Point2>& obstacles, double linear, double angular,
                        double max_distance) const;
   // Laser points beside both sides of the footprint within doorway_distance.
   bool inDoorway(const std::vector<common::Point2>& obstacles) const;
+  // frontClearance within the footprint's own width (no side margin).
+  double footprintClearance(const std::vector<common::Point2>& obstacles) const;
   // `local` (the pursued point, robot frame) moved across the way to it into the middle of a narrow gap.
   common::Point2 centredInGap(const std::vector<common::Point2>& obstacles, const common::Point2& local) const;
   // Turning in place at `angular`, with laser points inside the circle the footprint sweeps (+ side_margin): on
