@@ -41,7 +41,8 @@ cv::Mat1f distanceToOccupied(const common::OccupancyGrid& map) {
 // coarser.
 double reachResolution(const world::Environment& environment, const world::RenderOptions& options, double wanted) {
   const auto [low, high] = environment.bounds();
-  const double area = (high.x() - low.x() + 2.0 * options.margin + 1.0) * (high.y() - low.y() + 2.0 * options.margin + 1.0);
+  const double border = 2.0 * options.margin + 1.0;  // the margin both sides, and a metre for rounding
+  const double area = (high.x() - low.x() + border) * (high.y() - low.y() + border);
   return std::max(wanted, std::sqrt(area / common::kMaxMapCells));
 }
 
@@ -124,7 +125,8 @@ int run(int argc, char** argv) {
   const common::Pose2 world_from_map = evaluation::fitWorldFromMap(truth.poses, estimate.poses);
   const common::Pose2 start = truth.poses.front().pose;
   world::RenderOptions fine_options = render_options;
-  fine_options.resolution = std::min(render_options.resolution, reachResolution(environment, render_options, reach_resolution));
+  fine_options.resolution =
+      std::min(render_options.resolution, reachResolution(environment, render_options, reach_resolution));
   const world::RenderedEnvironment fine = world::renderEnvironment(environment, closed, fine_options);
   const cv::Mat1b reachable =
       evaluation::reachableFreeArea(rendered.map, fine.map, common::Point2(start.x, start.y), robot_radius);
@@ -148,7 +150,8 @@ int run(int argc, char** argv) {
          << "coverage_all_free: " << coverageOf(all_free)
          << "  # mapped free / true free cells 4-connected to the start (also behind gaps narrower than the robot)\n"
          << "robot_radius: " << robot_radius << "\n"
-         << "reach_resolution: " << fine_options.resolution << "  # metres per cell on which the body's reach is decided\n"
+         << "reach_resolution: " << fine_options.resolution
+         << "  # metres per cell on which the body's reach is decided\n"
          << "free_iou: " << all_free.free_iou << "\n"
          << "walls_within_2_cells: " << all_free.walls_within_2_cells << "\n"
          << "path_length: " << pathLength(truth.poses) << "  # metres, true trajectory\n"

@@ -200,7 +200,8 @@ TEST(DoorTranslation, ReachableAreaWithAClearanceStopsAtGapsNarrowerThanTheRobot
 common::OccupancyGrid twoRoomsWithAGap(double gap, double resolution) {
   common::OccupancyGrid grid;
   grid.resolution = resolution;
-  const int cols = static_cast<int>(std::lround(4.2 / resolution)), rows = static_cast<int>(std::lround(2.2 / resolution));
+  const int cols = static_cast<int>(std::lround(4.2 / resolution));
+  const int rows = static_cast<int>(std::lround(2.2 / resolution));
   grid.cells = cv::Mat_<int8_t>(rows, cols, common::OccupancyGrid::kFree);
   for (int row = 0; row < rows; ++row)
     for (int col = 0; col < cols; ++col) {
