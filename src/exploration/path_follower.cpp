@@ -458,9 +458,9 @@ FollowerStep PathFollower::follow(const common::Pose2& pose, const std::vector<c
   if (linear <= 1e-3) {
     // Blocked ahead. When only the lane's side margins hold what stops it (a wall's end beside its way, the
     // footprint's own width clear), creep straight on: the robot passes the wall's end at the side distance it
-    // has now, and then turns round it. Otherwise turn towards the path (the stall watch starts a recovery if
-    // nothing changes).
-    if (footprintClearance(obstacles) > options_.stop_distance) {
+    // has now, and then turns round it (creep_velocity 0: never). Otherwise turn towards the path (the stall watch
+    // starts a recovery if nothing changes).
+    if (options_.creep_velocity > 0.0 && footprintClearance(obstacles) > options_.stop_distance) {
       step.command.linear = options_.creep_velocity;
       step.command.angular = 0.0;
       return step;

@@ -185,6 +185,13 @@ TEST(PathFollower, CreepsStraightPastAWallsEndInTheLanesMargin) {
   step = follower.update(common::Pose2{}, blocked, 0.2);
   EXPECT_EQ(step.command.linear, 0.0);
   EXPECT_LT(step.command.angular, 0.0);
+  // With creep_velocity 0 it does not creep: it turns towards the path.
+  options.creep_velocity = 0.0;
+  PathFollower still(options);
+  still.setPath(bending, 0.0);
+  step = still.update(common::Pose2{}, wall_end, 0.1);
+  EXPECT_EQ(step.command.linear, 0.0);
+  EXPECT_LT(step.command.angular, 0.0);
 }
 
 TEST(PathFollower, IgnoresNonFiniteObstaclePoints) {
