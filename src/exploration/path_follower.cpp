@@ -131,12 +131,12 @@ double movingMargin(const std::vector<common::Point2>& obstacles, const PathFoll
 }
 
 // Free distance beyond the footprint's front (`direction` +1) or rear (-1) within its lane (the footprint's width
-// plus movingMargin each side). Points beside the footprint in the lane's side margins do not count (driving
-// straight does not bring them closer); points inside the footprint's half on that side give 0.
+// plus `margin` each side). Points beside the footprint in the lane's side margins do not count (driving straight
+// does not bring them closer); points inside the footprint's half on that side give 0.
 double laneClearance(const std::vector<common::Point2>& obstacles, const PathFollowerOptions& options,
-                     double direction) {
+                     double direction, double margin) {
   const double half_length = 0.5 * options.footprint_length, half_width = 0.5 * options.footprint_width;
-  const double half_lane = half_width + movingMargin(obstacles, options);
+  const double half_lane = half_width + margin;
   double clearance = kInfinity;
   for (const common::Point2& point : obstacles) {
     const double along = direction * point.x();
@@ -153,17 +153,11 @@ double laneClearance(const std::vector<common::Point2>& obstacles, const PathFol
 }  // namespace
 
 double frontClearance(const std::vector<common::Point2>& obstacles, const PathFollowerOptions& options) {
-  return laneClearance(obstacles, options, 1.0);
+  return laneClearance(obstacles, options, 1.0, movingMargin(obstacles, options));
 }
 
 double rearClearance(const std::vector<common::Point2>& obstacles, const PathFollowerOptions& options) {
-  return laneClearance(obstacles, options, -1.0);
-}
-
-double PathFollower::footprintClearance(const std::vector<common::Point2>& obstacles) const {
-  PathFollowerOptions no_margin = options_;
-  no_margin.side_margin = 0.0;
-  return laneClearance(obstacles, no_margin, 1.0);
+  return laneClearance(obstacles, options, -1.0, movingMargin(obstacles, options));
 }
 
 PathFollower::PathFollower(const PathFollowerOptions& options) : options_(options) { validate(options_); }
@@ -460,7 +454,7 @@ FollowerStep PathFollower::follow(const common::Pose2& pose, const std::vector<c
     // footprint's own width clear), creep straight on: the robot passes the wall's end at the side distance it
     // has now, and then turns round it (creep_velocity 0: never). Otherwise turn towards the path (the stall watch
     // starts a recovery if nothing changes).
-    if (options_.creep_velocity > 0.0 && footprintClearance(obstacles) > options_.stop_distance) {
+    if (options_.creep_velocity > 0.0 && laneClearance(obstacles, options_, 1.0, 0.0) > options_.stop_distance) {
       step.command.linear = options_.creep_velocity;
       step.command.angular = 0.0;
       return step;

@@ -146,8 +146,6 @@ class PathFollower {
                        double max_distance) const;
   // Laser points beside both sides of the footprint within doorway_distance.
   bool inDoorway(const std::vector<common::Point2>& obstacles) const;
-  // frontClearance within the footprint's own width (no side margin).
-  double footprintClearance(const std::vector<common::Point2>& obstacles) const;
   // `local` (the pursued point, robot frame) moved across the way to it into the middle of a narrow gap.
   common::Point2 centredInGap(const std::vector<common::Point2>& obstacles, const common::Point2& local) const;
   // Turning in place at `angular`, with laser points inside the circle the footprint sweeps (+ side_margin): on
