@@ -225,6 +225,11 @@ void ExplorationPolicy::choose(CostMap cost_map, const common::Pose2& pose, doub
     goal = nearest();
   }
   if (!goal) {
+    // No frontier can be reached: look past those the laser can see from where the robot can go.
+    if (planner_.searchWasBounded()) planner_.computeCostsFrom(robot);
+    goal = nearestLookGoal(frontiers_, planner_, blacklist_, options_.frontiers, previous, options_.goal_hysteresis);
+  }
+  if (!goal) {
     goal_.reset();
     follower_.stop();
     // Only plans on new maps count towards done (the map must have had the chance to change).
@@ -256,6 +261,7 @@ void ExplorationPolicy::choose(CostMap cost_map, const common::Pose2& pose, doub
     ExplorationEvent chosen = event(ExplorationEventType::kGoalChosen, goal->position);
     chosen.cost = goal->cost;
     chosen.path_length = pathLength(path);
+    chosen.look = goal->look;
     step->events.push_back(chosen);
   }
   goal_ = goal;

@@ -153,6 +153,9 @@ const common::OptionTable<FrontierOptions>& frontierOptionTable() {
       {"goal_reach", &O::goal_reach, "metres: a goal lies within this of a frontier cell", common::atLeast(0)},
       {"min_goal_distance", &O::min_goal_distance, "metres: and at least this far from the robot",
        common::atLeast(0)},
+      {"look_range", &O::look_range,
+       "metres: with no frontier reachable, a goal may look past a frontier cell from this far; 0 = off",
+       common::atLeast(0)},
       {"seen_wall_range", &O::seen_wall_range,
        "metres: a free cell at (or seen_wall_margin behind) the end of a beam at most this long, next to "
        "unknown space in a map seen_wall_delay later, is in a wall, no frontier; 0 = off",
@@ -278,6 +281,55 @@ std::optional<FrontierGoal> nearestFrontierGoal(const FrontierMap& frontiers, co
   const double cost = planner.costTo(col, row);
   if (!std::isfinite(cost) || cost > best->cost + hysteresis) return best;
   return FrontierGoal{claimed(row, col), {col, row}, map.cellCentre(col, row), cost};
+}
+
+std::optional<FrontierGoal> nearestLookGoal(const FrontierMap& frontiers, const GridPlanner& planner,
+                                            const Blacklist& blacklist, const FrontierOptions& options,
+                                            const std::optional<common::Point2>& previous, double hysteresis) {
+  const common::OccupancyGrid& map = planner.map();
+  if (options.look_range <= 0.0 || map.empty() || frontiers.frontiers.empty() || planner.startCell().x < 0)
+    return std::nullopt;
+  const auto inside = [&](int col, int row) { return col >= 0 && row >= 0 && col < map.width() && row < map.height(); };
+  const auto free = [&](int col, int row) {
+    const int value = map.cells(row, col);
+    return value >= 0 && value <= options.free_threshold;
+  };
+  const auto unknown = [&](int col, int row) {
+    if (!inside(col, row)) return true;
+    const int value = map.cells(row, col);
+    return value < 0 || (value > options.free_threshold && value < options.occupied_threshold);
+  };
+  const common::Point2 robot = map.cellCentre(planner.startCell().x, planner.startCell().y);
+  const cv::Mat1b& roomy = planner.roomy();
+  // Rays every 5 degrees from each frontier cell, in half-cell steps.
+  constexpr int kDirections = 72;
+  const double steps = 2.0 * options.look_range / map.resolution;
+  cv::Mat1i looking = cv::Mat1i::zeros(map.height(), map.width());  // per cell: a frontier it looks past
+  std::optional<FrontierGoal> best;
+  for (const Frontier& frontier : frontiers.frontiers)
+    for (const cv::Point& cell : frontier.cells)
+      for (int k = 0; k < kDirections; ++k) {
+        const double angle = 2.0 * CV_PI * k / kDirections;
+        const double dx = std::cos(angle), dy = std::sin(angle);
+        if (!unknown(cvRound(cell.x - dx), cvRound(cell.y - dy))) continue;  // nothing to see beyond the cell
+        for (int step = 1; step <= steps; ++step) {
+          const int col = cvRound(cell.x + 0.5 * step * dx), row = cvRound(cell.y + 0.5 * step * dy);
+          if (!inside(col, row) || !free(col, row)) break;
+          if (roomy(row, col) == 0 || looking(row, col) != 0) continue;
+          looking(row, col) = frontier.label;
+          const double cost = planner.costTo(col, row);
+          if (!std::isfinite(cost) || (best && cost >= best->cost)) continue;
+          const common::Point2 position = map.cellCentre(col, row);
+          if ((position - robot).norm() < options.min_goal_distance || blacklist.contains(position)) continue;
+          best = FrontierGoal{frontier.label, {col, row}, position, cost, true};
+        }
+      }
+  if (!best || !previous) return best;
+  int col = 0, row = 0;
+  if (!map.cellOf(*previous, &col, &row) || looking(row, col) == 0 || blacklist.contains(*previous)) return best;
+  const double cost = planner.costTo(col, row);
+  if (!std::isfinite(cost) || cost > best->cost + hysteresis) return best;
+  return FrontierGoal{looking(row, col), {col, row}, map.cellCentre(col, row), cost, true};
 }
 
 cv::Mat1b goalCandidates(const FrontierMap& frontiers, const GridPlanner& planner, const Blacklist& blacklist,

@@ -321,7 +321,8 @@ void Explorer::report(const exploration::ExplorationStep& step, const ros::Time&
         break;
       case exploration::ExplorationEventType::kGoalChosen:
         ++goals_chosen_;
-        ROS_DEBUG("explorer: goal (%.2f, %.2f), path %.2f m, cost %.2f", x, y, event.path_length, event.cost);
+        ROS_DEBUG("explorer: %sgoal (%.2f, %.2f), path %.2f m, cost %.2f",
+                  event.look ? "look " : "", x, y, event.path_length, event.cost);
         break;
       case exploration::ExplorationEventType::kGoalReached:
         ++goals_reached_;

@@ -389,5 +389,52 @@ TEST(Frontier, GoalsKeepRobotRadiusButPathsPassNarrowDoors) {
   EXPECT_LT(before_door->position.x(), 3.9);
 }
 
+TEST(Frontier, ALookGoalSeesPastAFrontierBehindAGapTooNarrowToPass) {
+  // Known room x = 0.2..4.0, a wall at x = 4.0..4.2 with a 0.4 m gap (rows 18..21: its centre 0.2 m from the
+  // jambs, under min_clearance); behind it only the strip the laser saw through the gap (x = 4.2..5.0), all else
+  // unknown. The strip's frontier cannot be reached, and no roomy cell of the room is within goal_reach of it.
+  common::OccupancyGrid grid = unknownGrid(100, 40);
+  grid.cells(cv::Rect(2, 0, 40, 40)).setTo(common::OccupancyGrid::kOccupied);
+  grid.cells(cv::Rect(3, 1, 37, 38)).setTo(common::OccupancyGrid::kFree);
+  grid.cells(cv::Rect(40, 18, 10, 4)).setTo(common::OccupancyGrid::kFree);  // the gap and the strip behind it
+  const FrontierMap frontiers = findFrontiers(grid);
+  ASSERT_EQ(frontiers.frontiers.size(), 1u);
+  GridPlanner planner;  // robot_radius 0.38, min_clearance 0.30
+  planner.setMap(grid);
+  ASSERT_TRUE(planner.computeCostsFrom(common::Point2(1.0, 1.0)));
+  EXPECT_FALSE(nearestFrontierGoal(frontiers, planner, Blacklist(), FrontierOptions()).has_value());
+
+  const std::optional<FrontierGoal> look = nearestLookGoal(frontiers, planner, Blacklist(), FrontierOptions());
+  ASSERT_TRUE(look.has_value());
+  EXPECT_TRUE(look->look);
+  EXPECT_LT(look->position.x(), 4.0);  // in the room, ...
+  EXPECT_GT(look->position.x(), 4.0 - FrontierOptions().look_range - 0.05);  // ... within look_range of the strip
+  EXPECT_NE(planner.roomy()(look->cell.y, look->cell.x), 0);
+  EXPECT_TRUE(std::isfinite(look->cost));
+  // It sees through the gap: the straight line from it to the gap's middle crosses only free cells.
+  const common::Point2 gap(4.1, 2.0);
+  for (double t = 0.0; t <= 1.0; t += 0.01) {
+    int col = 0, row = 0;
+    ASSERT_TRUE(grid.cellOf(look->position + t * (gap - look->position), &col, &row));
+    EXPECT_EQ(grid.cells(row, col), common::OccupancyGrid::kFree) << "at t = " << t;
+  }
+
+  // Blacklisted there, another place; off with look_range 0; none with the gap walled up.
+  Blacklist blacklist;
+  blacklist.points.push_back(look->position);
+  const std::optional<FrontierGoal> other = nearestLookGoal(frontiers, planner, blacklist, FrontierOptions());
+  ASSERT_TRUE(other.has_value());
+  EXPECT_GT((other->position - look->position).norm(), blacklist.radius);
+  FrontierOptions off;
+  off.look_range = 0.0;
+  EXPECT_FALSE(nearestLookGoal(frontiers, planner, Blacklist(), off).has_value());
+  grid.cells(cv::Rect(40, 18, 2, 4)).setTo(common::OccupancyGrid::kOccupied);
+  planner.setMap(grid);
+  ASSERT_TRUE(planner.computeCostsFrom(common::Point2(1.0, 1.0)));
+  const FrontierMap walled = findFrontiers(grid);
+  ASSERT_EQ(walled.frontiers.size(), 1u);
+  EXPECT_FALSE(nearestLookGoal(walled, planner, Blacklist(), FrontierOptions()).has_value());
+}
+
 }  // namespace
 }  // namespace hidden_rooms::exploration

@@ -41,7 +41,8 @@ const common::OptionTable<ExplorationPolicyOptions>& explorationPolicyOptionTabl
 enum class ExplorationEventType {
   kMapUnusable,       // the map set last could not be used (`message`): the plan did nothing, the old map stays
   kStartBlocked,      // the robot (`position`) is not within start_escape_radius of a traversable cell: no plan
-  kGoalChosen,        // a new goal at `position` (`cost`, `path_length`); a replan of the same goal is none
+  kGoalChosen,        // a new goal at `position` (`cost`, `path_length`, `look`); a replan of the same goal is
+                      // none
   kGoalReached,       // the goal at `position` was reached; blacklisted
   kGoalFailed,        // not reached at `position` after `recoveries` while the robot moved; blacklisted, with a
                       // second try later when `retry_later`
@@ -67,6 +68,7 @@ struct ExplorationEvent {
   bool retry_later = false;          // kGoalFailed: it gets a second try when nothing else is left
   double cost = 0.0;                 // kGoalChosen: path cost
   double path_length = 0.0;          // kGoalChosen: metres
+  bool look = false;                 // kGoalChosen: a look goal (nearestLookGoal): no frontier is reachable
   std::string message;               // kMapUnusable: why
 };
 

@@ -20,6 +20,10 @@ struct FrontierOptions {
   int min_unknown_cells = 20;    // unknown areas (4-connected) with fewer cells are specks, not frontier material
   double goal_reach = 0.6;       // metres: a goal is a traversable cell within this distance of the frontier ...
   double min_goal_distance = 0.5;  // ... and at least this far from the robot (a goal at the robot teaches nothing)
+  // When no frontier can be reached, the robot looks at them from where it can: a look goal is a roomy reachable
+  // cell at most look_range from a frontier cell, with a line of free cells to it that would go on into the
+  // unknown space beside that cell (rooms behind gaps the robot does not fit through). 0 = off.
+  double look_range = 3.0;  // metres
   // A free cell where a laser beam at most seen_wall_range long ended, or up to seen_wall_margin behind that end,
   // lies in a wall the laser sees; when a map made seen_wall_delay seconds later still shows it next to unknown
   // space, that space is the wall's inside (a wall the map draws a few cm off, with holes), not unexplored: no
@@ -153,6 +157,7 @@ struct FrontierGoal {
   cv::Point cell;          // the goal cell (traversable, reachable)
   common::Point2 position = common::Point2::Zero();       // its centre, map frame
   double cost = std::numeric_limits<double>::infinity();  // the planner's path cost to it
+  bool look = false;       // a place to look past a frontier from (nearestLookGoal), not to reach it
 };
 
 // The frontier nearest by path cost: over every roomy cell (planner.roomy(): at least robot_radius from obstacles)
@@ -165,6 +170,17 @@ std::optional<FrontierGoal> nearestFrontierGoal(const FrontierMap& frontiers, co
                                                 const Blacklist& blacklist, const FrontierOptions& options,
                                                 const std::optional<common::Point2>& previous = std::nullopt,
                                                 double hysteresis = 1.0);
+
+// The nearest look goal (FrontierOptions::look_range; nothing when it is 0): over every roomy cell reachable in
+// `planner`'s last search from which a straight line of free cells, at most look_range long, reaches a frontier
+// cell whose cell just beyond along that line is unknown, that is at least min_goal_distance from the search's
+// start cell and not in `blacklist`, the cheapest. `previous` and `hysteresis` as for nearestFrontierGoal (the
+// previous goal is kept while it is still such a cell). Meant for when nearestFrontierGoal finds nothing: the
+// search must then have costs everywhere (not bounded by goal candidates).
+std::optional<FrontierGoal> nearestLookGoal(const FrontierMap& frontiers, const GridPlanner& planner,
+                                            const Blacklist& blacklist, const FrontierOptions& options,
+                                            const std::optional<common::Point2>& previous = std::nullopt,
+                                            double hysteresis = 1.0);
 
 // Cells that nearestFrontierGoal surely accepts as goals: roomy cells within options.goal_reach of a frontier cell,
 // not in `blacklist`, and at least options.min_goal_distance + `extra_distance` from `robot` (the search's start
