@@ -84,9 +84,10 @@ struct ExplorationStep {
 // path to it; pure pursuit along it with the laser points of the last obstacle_memory seconds. A reached goal is
 // blacklisted; a failed one too, and its failures may block the passage ahead. When no goal is left, blocked
 // goals are released in this order, each only when the ones before gave no goal: the places where the robot was
-// stuck, the blocked passages (once), the failed places (their one second try). Done after done_confirmations
-// plans on new maps in a row without a goal; until then, and without a goal, it turns in place. Times are seconds
-// of a monotonic clock (the node uses ROS time); differences within half a nanosecond count as equal. With
+// stuck, the blocked passages (once), the failed places (their one second try); with still none, a place to look
+// past a frontier from (nearestLookGoal). Done after done_confirmations plans on new maps in a row without a goal;
+// until then, and without a goal, it turns in place. Times are seconds of a monotonic clock (the node uses ROS
+// time); differences within half a nanosecond count as equal. With
 // background_planning, a plan started at one update is used at the first update after it finished (the robot
 // keeps following its path meanwhile, stands still when its goal ended, and turns in place when it had none);
 // one plan runs at a time.
