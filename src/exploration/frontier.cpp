@@ -1,6 +1,7 @@
 #include "hidden_rooms/exploration/frontier.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -11,6 +12,28 @@
 
 namespace hidden_rooms::exploration {
 
+namespace {
+
+// 255 where the frontiers count a cell as unknown: -1, and uncertain cells (seen too rarely to be free or occupied).
+cv::Mat1b unknownCells(const common::OccupancyGrid& map, const FrontierOptions& options) {
+  return (map.cells < 0) | ((map.cells > options.free_threshold) & (map.cells < options.occupied_threshold));
+}
+
+// The goal a search keeps (nearestFrontierGoal, nearestLookGoal): `previous` while `claims` (per cell: the frontier
+// it serves, 0 none) still has it, it is not blacklisted and it costs at most `hysteresis` more than `best`; else
+// `best`.
+FrontierGoal keptGoal(const FrontierGoal& best, const common::Point2& previous, const cv::Mat1i& claims,
+                      const GridPlanner& planner, const Blacklist& blacklist, double hysteresis) {
+  const common::OccupancyGrid& map = planner.map();
+  int col = 0, row = 0;
+  if (!map.cellOf(previous, &col, &row) || claims(row, col) == 0 || blacklist.contains(previous)) return best;
+  const double cost = planner.costTo(col, row);
+  if (!std::isfinite(cost) || cost > best.cost + hysteresis) return best;
+  return FrontierGoal{claims(row, col), {col, row}, map.cellCentre(col, row), cost, best.look};
+}
+
+}  // namespace
+
 FrontierMap findFrontiers(const common::OccupancyGrid& map, const FrontierOptions& options,
                           const cv::Mat1b& seen_walls) {
   FrontierMap result;
@@ -19,8 +42,7 @@ FrontierMap findFrontiers(const common::OccupancyGrid& map, const FrontierOption
   result.labels = cv::Mat1i::zeros(rows, cols);
 
   // Unknown areas big enough to be worth exploring (4-connected, as the frontier test below looks at them).
-  // Uncertain cells (seen too rarely to be free or occupied) are as good as unknown.
-  const cv::Mat1b unknown = (map.cells < 0) | ((map.cells > options.free_threshold) & (map.cells < options.occupied_threshold));
+  const cv::Mat1b unknown = unknownCells(map, options);
   cv::Mat1i unknown_labels, unknown_stats;
   cv::Mat centroids;
   cv::connectedComponentsWithStats(unknown, unknown_labels, unknown_stats, centroids, 4, CV_32S);
@@ -274,13 +296,7 @@ std::optional<FrontierGoal> nearestFrontierGoal(const FrontierMap& frontiers, co
     }
   }
   if (!best || !previous) return best;
-
-  // Keep the previous goal while a frontier still claims it and it is not much dearer than the best.
-  int col = 0, row = 0;
-  if (!map.cellOf(*previous, &col, &row) || claimed(row, col) == 0 || blacklist.contains(*previous)) return best;
-  const double cost = planner.costTo(col, row);
-  if (!std::isfinite(cost) || cost > best->cost + hysteresis) return best;
-  return FrontierGoal{claimed(row, col), {col, row}, map.cellCentre(col, row), cost};
+  return keptGoal(*best, *previous, claimed, planner, blacklist, hysteresis);
 }
 
 std::optional<FrontierGoal> nearestLookGoal(const FrontierMap& frontiers, const GridPlanner& planner,
@@ -294,24 +310,23 @@ std::optional<FrontierGoal> nearestLookGoal(const FrontierMap& frontiers, const 
     const int value = map.cells(row, col);
     return value >= 0 && value <= options.free_threshold;
   };
-  const auto unknown = [&](int col, int row) {
-    if (!inside(col, row)) return true;
-    const int value = map.cells(row, col);
-    return value < 0 || (value > options.free_threshold && value < options.occupied_threshold);
-  };
+  const cv::Mat1b unknown = unknownCells(map, options);  // beyond the grid counts as unknown too
   const common::Point2 robot = map.cellCentre(planner.startCell().x, planner.startCell().y);
   const cv::Mat1b& roomy = planner.roomy();
   // Rays every 5 degrees from each frontier cell, in half-cell steps.
   constexpr int kDirections = 72;
+  std::array<common::Point2, kDirections> directions;
+  for (int k = 0; k < kDirections; ++k)
+    directions[k] = common::Point2(std::cos(2.0 * CV_PI * k / kDirections), std::sin(2.0 * CV_PI * k / kDirections));
   const double steps = 2.0 * options.look_range / map.resolution;
   cv::Mat1i looking = cv::Mat1i::zeros(map.height(), map.width());  // per cell: a frontier it looks past
   std::optional<FrontierGoal> best;
   for (const Frontier& frontier : frontiers.frontiers)
     for (const cv::Point& cell : frontier.cells)
-      for (int k = 0; k < kDirections; ++k) {
-        const double angle = 2.0 * CV_PI * k / kDirections;
-        const double dx = std::cos(angle), dy = std::sin(angle);
-        if (!unknown(cvRound(cell.x - dx), cvRound(cell.y - dy))) continue;  // nothing to see beyond the cell
+      for (const common::Point2& direction : directions) {
+        const double dx = direction.x(), dy = direction.y();
+        const int behind_col = cvRound(cell.x - dx), behind_row = cvRound(cell.y - dy);
+        if (inside(behind_col, behind_row) && unknown(behind_row, behind_col) == 0) continue;  // nothing beyond
         for (int step = 1; step <= steps; ++step) {
           const int col = cvRound(cell.x + 0.5 * step * dx), row = cvRound(cell.y + 0.5 * step * dy);
           if (!inside(col, row) || !free(col, row)) break;
@@ -325,11 +340,7 @@ std::optional<FrontierGoal> nearestLookGoal(const FrontierMap& frontiers, const 
         }
       }
   if (!best || !previous) return best;
-  int col = 0, row = 0;
-  if (!map.cellOf(*previous, &col, &row) || looking(row, col) == 0 || blacklist.contains(*previous)) return best;
-  const double cost = planner.costTo(col, row);
-  if (!std::isfinite(cost) || cost > best->cost + hysteresis) return best;
-  return FrontierGoal{looking(row, col), {col, row}, map.cellCentre(col, row), cost, true};
+  return keptGoal(*best, *previous, looking, planner, blacklist, hysteresis);
 }
 
 cv::Mat1b goalCandidates(const FrontierMap& frontiers, const GridPlanner& planner, const Blacklist& blacklist,

@@ -41,8 +41,8 @@ const common::OptionTable<ExplorationPolicyOptions>& explorationPolicyOptionTabl
 enum class ExplorationEventType {
   kMapUnusable,       // the map set last could not be used (`message`): the plan did nothing, the old map stays
   kStartBlocked,      // the robot (`position`) is not within start_escape_radius of a traversable cell: no plan
-  kGoalChosen,        // a new goal at `position` (`cost`, `path_length`, `look`); a replan of the same goal is
-                      // none
+  kGoalChosen,        // a new goal at `position` (`cost`, `path_length`, `look`); replanning the same goal is
+                      // no new goal
   kGoalReached,       // the goal at `position` was reached; blacklisted
   kGoalFailed,        // not reached at `position` after `recoveries` while the robot moved; blacklisted, with a
                       // second try later when `retry_later`
