@@ -15,6 +15,9 @@ const common::OptionTable<ExplorationPolicyOptions>& explorationPolicyOptionTabl
        common::atLeast(1)},
       {"search_angular_velocity", &O::search_angular_velocity, "rad/s turned in place while there is no goal"},
       {"obstacle_memory", &O::obstacle_memory, "seconds the laser points of past scans are kept", common::atLeast(0)},
+      {"trail_length", &O::trail_length,
+       "metres of the robot's latest path the planner may use however narrow once nothing else is left; 0 = never",
+       common::atLeast(0)},
   };
   return table;
 }
@@ -23,6 +26,8 @@ namespace {
 
 // Half ROS time's resolution: time differences closer than this to a threshold reach it.
 constexpr double kTimeEpsilon = 0.5e-9;
+// Metres between the points of the robot's trail (a map cell or so).
+constexpr double kTrailSpacing = 0.05;
 
 ExplorationEvent event(ExplorationEventType type, const common::Point2& position = common::Point2::Zero(),
                        size_t count = 0) {
@@ -69,6 +74,7 @@ void ExplorationPolicy::hold(double time) { follower_.hold(time); }
 
 ExplorationStep ExplorationPolicy::update(const common::Pose2& pose, double time) {
   ExplorationStep step;
+  recordTrail(common::Point2(pose.x, pose.y));
   // The follower sees the latest scan and the remembered ones (placed with the robot's current pose).
   const std::vector<common::Point2> obstacles = obstacle_memory_.points(pose);
 
@@ -105,6 +111,22 @@ ExplorationStep ExplorationPolicy::update(const common::Pose2& pose, double time
   return step;
 }
 
+void ExplorationPolicy::recordTrail(const common::Point2& position) {
+  if (options_.trail_length <= 0.0) return;
+  if (!trail_.empty()) {
+    const double step = (position - trail_.back()).norm();
+    if (step < kTrailSpacing) return;
+    trail_metres_ += step;
+  }
+  trail_.push_back(position);
+  size_t drop = 0;
+  while (trail_.size() - drop > 2 && trail_metres_ > options_.trail_length) {
+    trail_metres_ -= (trail_[drop + 1] - trail_[drop]).norm();
+    ++drop;
+  }
+  trail_.erase(trail_.begin(), trail_.begin() + static_cast<std::ptrdiff_t>(drop));
+}
+
 void ExplorationPolicy::finishGoal(const common::Pose2& pose, FollowerState outcome, ExplorationStep* step) {
   // A reached goal whose frontier is still there next time cannot be seen from there: no goal near it again.
   // A failed one gets one more try when nothing else is left; one failed because the robot could not move at
@@ -133,16 +155,19 @@ void ExplorationPolicy::finishGoal(const common::Pose2& pose, FollowerState outc
                                  robot));
   }
   goal_.reset();
+  trail_open_ = false;
 }
 
 ExplorationPolicy::CostMap ExplorationPolicy::computeCostMap(const ExplorationPolicyOptions& options,
                                                              const Blacklist& blacklist,
                                                              const std::vector<common::Point2>& blocked_points,
+                                                             const std::vector<common::Point2>& trail,
                                                              const common::OccupancyGrid& map,
                                                              const cv::Mat1b& seen_walls,
                                                              const common::Point2& robot, bool new_map) {
   CostMap result{GridPlanner(options.planner), FrontierMap(), false, new_map};
   result.planner.setBlockedPoints(blocked_points, options.passages.radius);
+  result.planner.setTrail(trail);
   result.planner.setMap(map);
   result.frontiers = findFrontiers(result.planner.map(), options.frontiers, seen_walls);
   const cv::Mat1b targets = goalCandidates(result.frontiers, result.planner, blacklist, options.frontiers, robot,
@@ -173,12 +198,13 @@ void ExplorationPolicy::plan(const common::Pose2& pose, double time, Exploration
   const cv::Mat1b seen_walls = seen_walls_.seenBy(map_time_ - options_.frontiers.seen_wall_delay);
   const common::Point2 robot(pose.x, pose.y);
   if (!options_.background_planning) {
-    choose(computeCostMap(options_, blacklist_, passages_.blockedPoints(), map, seen_walls, robot, new_map), pose,
-           time, step);
+    choose(computeCostMap(options_, blacklist_, passages_.blockedPoints(), openTrail(), map, seen_walls, robot,
+                          new_map),
+           pose, time, step);
     return;
   }
   background_plan_ = std::async(std::launch::async, &ExplorationPolicy::computeCostMap, options_, blacklist_,
-                                passages_.blockedPoints(), map, seen_walls, robot, new_map);
+                                passages_.blockedPoints(), openTrail(), map, seen_walls, robot, new_map);
 }
 
 void ExplorationPolicy::choose(CostMap cost_map, const common::Pose2& pose, double time, ExplorationStep* step) {
@@ -223,6 +249,15 @@ void ExplorationPolicy::choose(CostMap cost_map, const common::Pose2& pose, doub
   if (!goal && !blacklist_.failed_points.empty()) {
     step->events.push_back(event(ExplorationEventType::kFailedReleased, robot, blacklist_.releaseFailed()));
     goal = nearest();
+  }
+  if (!goal && !trail_open_ && trail_.size() > 1 && !frontiers_.frontiers.empty()) {
+    // No frontier can be reached: the way the robot came in is a way out, however narrow the map now draws it.
+    trail_open_ = true;
+    ExplorationEvent opened = event(ExplorationEventType::kTrailOpened, robot);
+    opened.path_length = trail_metres_;
+    step->events.push_back(opened);
+    planner_.setTrail(trail_);
+    if (planner_.computeCostsFrom(robot)) goal = nearest();
   }
   if (!goal) {
     // No frontier can be reached: look past those the laser can see from where the robot can go.

@@ -16,6 +16,7 @@ namespace hidden_rooms::exploration {
 namespace {
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
+constexpr double kMaxTrailStep = 1.0;  // metres: longer steps of a trail are jumps of the pose, not driven
 
 }  // namespace
 
@@ -90,6 +91,17 @@ void GridPlanner::setMap(const common::OccupancyGrid& map) {
       const double narrow = distance < options_.robot_radius ? options_.narrow_cost_factor : 1.0;
       step_factor_(row, col) = static_cast<float>(narrow * (1.0 + options_.cost_weight * closeness));
     }
+  for (size_t i = 1; i < trail_.size(); ++i) {
+    int col_a = 0, row_a = 0, col_b = 0, row_b = 0;
+    if ((trail_[i] - trail_[i - 1]).norm() > kMaxTrailStep || !map.cellOf(trail_[i - 1], &col_a, &row_a) ||
+        !map.cellOf(trail_[i], &col_b, &row_b))
+      continue;
+    cv::LineIterator cell(traversable_, {col_a, row_a}, {col_b, row_b}, 4);  // the search cuts no corners
+    for (int k = 0; k < cell.count; ++k, ++cell) {
+      const int value = map.cells(cell.pos());
+      if (value >= 0 && value <= options_.free_threshold) traversable_(cell.pos()) = 255;
+    }
+  }
   const int blocked_cells = static_cast<int>(std::lround(blocked_radius_ / map.resolution));
   for (const common::Point2& point : blocked_points_) {
     int col = 0, row = 0;
@@ -97,6 +109,12 @@ void GridPlanner::setMap(const common::OccupancyGrid& map) {
     cv::circle(traversable_, {col, row}, blocked_cells, 0, cv::FILLED);
     cv::circle(roomy_, {col, row}, blocked_cells, 0, cv::FILLED);
   }
+}
+
+void GridPlanner::setTrail(const std::vector<common::Point2>& trail) {
+  trail_ = trail;
+  const common::OccupancyGrid map = map_;
+  setMap(map);
 }
 
 void GridPlanner::setBlockedPoints(const std::vector<common::Point2>& points, double radius) {

@@ -554,9 +554,10 @@ def parse_arguments(argv):
     parser.add_argument("--patience", type=int, default=3,
                         help="stop after this many saved maps in a row that did not grow (1 = the thesis's rule)")
     parser.add_argument("--max-time", type=float, default=1800.0, help="simulated seconds at most per world")
-    parser.add_argument("--realtime-factor", type=float, default=10.0,
-                        help="simulated seconds per wall second (at 10 the explorer, planning in the background, and "
-                             "the mapper keep up on 2 cores); 0 = lockstep: the simulator steps on when the mapper "
+    parser.add_argument("--realtime-factor", type=float, default=12.0,
+                        help="simulated seconds per wall second (at 12 the explorer, planning in the background, and "
+                             "the mapper keep up on 2 cores, and a campaign, start and stop of each world included, "
+                             "goes at 10x or more); 0 = lockstep: the simulator steps on when the mapper "
                              "and the explorer have handled each scan, as fast as the machine allows, and a seed "
                              "gives the same run every time")
     parser.add_argument("--seed", type=int, default=0, help="seed of the simulator and the filter")

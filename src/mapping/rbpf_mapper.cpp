@@ -30,6 +30,8 @@ namespace hidden_rooms::mapping {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
+// Scans the rendering's checkpoint stays behind the newest (paths of the best particle part within the last ones).
+constexpr size_t kCheckpointLag = 50;
 
 mrpt::poses::CPose2D toMrpt(const common::Pose2& pose) { return mrpt::poses::CPose2D(pose.x, pose.y, pose.yaw); }
 common::Pose2 fromMrpt(const mrpt::math::TPose3D& pose) { return {pose.x, pose.y, pose.yaw}; }
@@ -134,6 +136,11 @@ struct RbpfMapper::Impl {
   // path starts with the same poses only adds the new scans).
   mutable std::optional<mrpt::maps::COccupancyGridMap2D> rendered;
   mutable std::vector<mrpt::math::TPose3D> rendered_poses;
+  // A copy of the rendering after its first checkpoint_scans scans, made kCheckpointLag scans behind the newest
+  // while drawing: a new path that parts from the rendered one only after them is drawn on from the copy instead of
+  // from scratch (the same cells: scans are drawn in the same order at the same poses).
+  mutable std::optional<mrpt::maps::COccupancyGridMap2D> checkpoint;
+  mutable size_t checkpoint_scans = 0;
 
   size_t mappedParticle() const;
   const mrpt::maps::COccupancyGridMap2D& publishedGrid() const;
@@ -336,14 +343,24 @@ const mrpt::maps::COccupancyGridMap2D& RbpfMapper::Impl::publishedGrid() const {
   while (same < rendered_poses.size() && same < inserted_scans.size() &&
          path[inserted_path_index[same]] == rendered_poses[same])
     ++same;
-  if (!rendered || same < rendered_poses.size()) {  // another path: draw all scans again
+  if (rendered && same < rendered_poses.size() && checkpoint && same >= checkpoint_scans) {
+    rendered = *checkpoint;  // another path, the same as far as the checkpoint: draw on from there
+    rendered_poses.resize(checkpoint_scans);
+  } else if (!rendered || same < rendered_poses.size()) {  // another path: draw all scans again
     const auto filter_grid = builder->getCurrentlyBuiltMetricMap()->mapByClass<mrpt::maps::COccupancyGridMap2D>(0);
     rendered.emplace(filter_grid->getXMin(), filter_grid->getXMax(), filter_grid->getYMin(), filter_grid->getYMax(),
                      filter_grid->getResolution());
     rendered->insertionOptions = published_insertion;
     rendered_poses.clear();
+    checkpoint.reset();
+    checkpoint_scans = 0;
   }
+  const size_t next_checkpoint = inserted_scans.size() > kCheckpointLag ? inserted_scans.size() - kCheckpointLag : 0;
   for (size_t k = rendered_poses.size(); k < inserted_scans.size(); ++k) {
+    if (k == next_checkpoint && k >= checkpoint_scans + kCheckpointLag) {
+      checkpoint = *rendered;
+      checkpoint_scans = k;
+    }
     const mrpt::math::TPose3D& pose = path[inserted_path_index[k]];
     rendered->insertObservation(*inserted_scans[k], mrpt::poses::CPose3D(pose));
     rendered_poses.push_back(pose);

@@ -356,6 +356,10 @@ void Explorer::report(const exploration::ExplorationStep& step, const ros::Time&
       case exploration::ExplorationEventType::kFailedReleased:
         ROS_WARN("explorer: no other goal; %zu failed goals get their second try", event.count);
         break;
+      case exploration::ExplorationEventType::kTrailOpened:
+        ROS_WARN("explorer: no other goal; the robot's last %.1f m of path are passable however narrow the map "
+                 "draws them (the way in is a way out)", event.path_length);
+        break;
       case exploration::ExplorationEventType::kNoGoal:
         ROS_INFO("explorer: no reachable frontier (%zu frontiers, %zu blacklisted places); checking again",
                  event.count, event.blacklisted);

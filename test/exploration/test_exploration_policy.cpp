@@ -301,6 +301,39 @@ TEST(ExplorationPolicy, DoneOnlyAfterTheConfiguredPlansWithoutAGoal) {
   EXPECT_GT(step.command.linear, 0.0);
 }
 
+// The corridor open on the right with a wall across at x = 6.0 and a 0.4 m gap in it on the centre line: closer than
+// min_clearance (0.30 m) to its jambs everywhere, so the map draws it closed for the planner.
+common::OccupancyGrid corridorWithNarrowGap() {
+  common::OccupancyGrid grid = corridor(false, true);
+  grid.cells(cv::Rect(60, 1, 1, 13)).setTo(common::OccupancyGrid::kOccupied);
+  grid.cells(cv::Rect(60, 18, 1, 13)).setTo(common::OccupancyGrid::kOccupied);
+  return grid;
+}
+
+TEST(ExplorationPolicy, WhenNothingElseIsLeftTheWayInIsAWayOut) {
+  // The robot drove from x = 8.0 through the gap to x = 3.0 while the map had no frontier; then the map draws the
+  // gap too narrow and the only frontier lies behind it. With nothing else left, its trail opens the gap.
+  for (const double trail_length : {20.0, 0.0}) {
+    ExplorationPolicyOptions options = quickFailures();
+    options.trail_length = trail_length;
+    ExplorationPolicy policy(options);
+    policy.setMap(closedRoom());
+    double time = 0.0;
+    for (double x = 8.0; x >= 3.0 - 1e-9; x -= 0.05) policy.update(common::Pose2{x, kCentreY, M_PI}, time += 0.1);
+    policy.setMap(corridorWithNarrowGap());
+    const ExplorationStep step = policy.update(common::Pose2{3.0, kCentreY, 0.0}, time += 0.1);  // turned round
+    if (trail_length == 0.0) {
+      EXPECT_EQ(types(step), std::vector<Type>{Type::kNoGoal});
+      continue;
+    }
+    ASSERT_EQ(types(step), (std::vector<Type>{Type::kTrailOpened, Type::kGoalChosen}));
+    EXPECT_NEAR(first(step, Type::kTrailOpened).path_length, 5.0, 0.1);
+    EXPECT_NEAR(first(step, Type::kGoalChosen).position.x(), kRightGoalX, 1e-9);
+    EXPECT_FALSE(first(step, Type::kGoalChosen).look);
+    EXPECT_GT(step.command.linear, 0.0);
+  }
+}
+
 TEST(ExplorationPolicy, KeepsItsGoalUnlessAnotherIsCheaperByTheHysteresis) {
   ExplorationPolicyOptions options;
   options.goal_hysteresis = 1.0;

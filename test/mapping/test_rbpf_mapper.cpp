@@ -59,9 +59,10 @@ struct MappingRun {
 };
 
 // Drives the robot (wander) through a world for `seconds` and maps it with scans at 10 Hz, with the mapper's
-// ini `config`, from the simulator's odometry or (`drift`) that odometry drifting further.
+// ini `config`, from the simulator's odometry or (`drift`) that odometry drifting further; with `map_every`, takes
+// the map after every that many scans as well (as the node publishes it).
 MappingRun mapWorld(const std::string& world_file, double seconds, uint32_t mapper_seed,
-                    const std::string& config = kConfig, bool drift = false) {
+                    const std::string& config = kConfig, bool drift = false, int map_every = 0) {
   const world::Environment environment = world::loadEnvironment(world_file);
   const world::RenderedEnvironment truth = world::renderEnvironment(environment, {});
   simulation::SimulationOptions options;
@@ -96,6 +97,7 @@ MappingRun mapWorld(const std::string& world_file, double seconds, uint32_t mapp
     estimate.push_back(mapper.pose());
     true_poses.push_back(simulation.truePose());
     ++run.scans;
+    if (map_every > 0 && run.scans % map_every == 0) mapper.map();
   }
   // Scored as map_from_bag scores: the map placed in the world by the rigid fit of the whole trajectory as the
   // mapper estimates it at the end (loop closures move earlier poses).
@@ -151,6 +153,28 @@ TEST(RbpfMapper, SameScansAndSeedGiveTheSameMap) {
   ASSERT_EQ(a.map.cells.size(), b.map.cells.size());
   EXPECT_EQ(cv::countNonZero(a.map.cells != b.map.cells), 0);
   EXPECT_EQ(a.map.origin, b.map.origin);
+}
+
+TEST(RbpfMapper, AMapTakenAtEveryPublicationHasTheCellsOfOneDrawnOnce) {
+  // Taken every 2 s, the map is drawn on along the best particle's path, from the copy of its rendering kept behind
+  // the newest scans when that path changes; taken once, every scan is drawn along the final path. The grids may
+  // have grown differently, but the cells they share are the same and they know the same cells.
+  const std::string world = std::string(HIDDEN_ROOMS_SOURCE_DIR) + "/worlds/small_1.xml";
+  const MappingRun published = mapWorld(world, 150.0, 1, kConfig, false, 20), once = mapWorld(world, 150.0, 1);
+  ASSERT_GT(published.inserted, 120);  // well past the copy's 50 scans
+  const common::OccupancyGrid &a = published.map, &b = once.map;
+  ASSERT_NEAR(a.resolution, b.resolution, 1e-9);
+  const common::Point2 shift = (a.origin - b.origin) / a.resolution;  // a's cell (0, 0) in b's cells
+  const int dx = static_cast<int>(std::lround(shift.x())), dy = static_cast<int>(std::lround(shift.y()));
+  ASSERT_NEAR(shift.x(), dx, 1e-6);
+  ASSERT_NEAR(shift.y(), dy, 1e-6);
+  // Rows count from the top: a's row r is b's row r + (b.height - a.height) - dy.
+  const int row_shift = b.height() - a.height() - dy;
+  const cv::Rect in_b = cv::Rect(dx, row_shift, a.width(), a.height()) & cv::Rect(0, 0, b.width(), b.height());
+  const cv::Rect in_a = in_b - cv::Point(dx, row_shift);
+  EXPECT_EQ(cv::countNonZero(a.cells(in_a) != b.cells(in_b)), 0);
+  EXPECT_EQ(cv::countNonZero(a.cells != common::OccupancyGrid::kUnknown),
+            cv::countNonZero(b.cells != common::OccupancyGrid::kUnknown));
 }
 
 TEST(RbpfMapper, StartsAtTheFirstOdometryPose) {

@@ -221,7 +221,7 @@ class ExploreWorldsTest(unittest.TestCase):
                 shutil.copy(WORLD, worlds[-1])
             # 20 s: at 10x the mapper needs a few simulated seconds to start; a run with no map at its end fails.
             result = run(*worlds, "--out", os.path.join(folder, "out"), "--max-time", "20", "--method", "",
-                         "--jobs", "2", "--no-progress", timeout=300)
+                         "--jobs", "2", "--no-progress", "--realtime-factor", "10", timeout=300)
             self.assertEqual(result.returncode, 0, result.stdout + result.stderr)
             with open(os.path.join(folder, "out", "summary.csv")) as summary_file:
                 rows = list(csv.DictReader(summary_file))

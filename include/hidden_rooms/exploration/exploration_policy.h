@@ -28,6 +28,7 @@ struct ExplorationPolicyOptions {
   int done_confirmations = 3;       // plans on new maps in a row without a reachable frontier before done
   double search_angular_velocity = 0.4;  // rad/s turned in place while there is no goal (and not done)
   double obstacle_memory = 1.5;     // seconds laser points are remembered (for the robot's blind rear)
+  double trail_length = 20.0;       // metres of the robot's latest path made passable when nothing else is (0 = never)
   // The costly part of a plan (the map's cost map, the frontiers, the costs from the robot) on a thread of its
   // own, so that update() keeps steering along the current path meanwhile; the goal is chosen at the first update
   // after it finished. Off: update() plans in place (deterministic: the same inputs give the same commands).
@@ -53,6 +54,8 @@ enum class ExplorationEventType {
   kStuckReleased,     // no other goal: `count` places of goals failed with the robot stuck are tried again
   kPassagesReleased,  // no other goal: `count` blocked points opened again (once per run)
   kFailedReleased,    // no other goal: `count` failed places get their second try
+  kTrailOpened,       // no other goal: the robot's latest `path_length` metres of path are passable until the goal
+                      // they give ends
   kNoGoal,            // no reachable frontier (`count` frontiers, `blacklisted` places), not done yet
   kDone,              // done_confirmations plans on new maps in a row found no goal (`blacklisted` places)
   kResumed,           // after done, a reachable frontier appeared
@@ -67,7 +70,7 @@ struct ExplorationEvent {
   int recoveries = 0;                // of the failed goal
   bool retry_later = false;          // kGoalFailed: it gets a second try when nothing else is left
   double cost = 0.0;                 // kGoalChosen: path cost
-  double path_length = 0.0;          // kGoalChosen: metres
+  double path_length = 0.0;          // kGoalChosen, kTrailOpened: metres
   bool look = false;                 // kGoalChosen: a look goal (nearestLookGoal): no frontier is reachable
   std::string message;               // kMapUnusable: why
 };
@@ -84,10 +87,11 @@ struct ExplorationStep {
 // path to it; pure pursuit along it with the laser points of the last obstacle_memory seconds. A reached goal is
 // blacklisted; a failed one too, and its failures may block the passage ahead. When no goal is left, blocked
 // goals are released in this order, each only when the ones before gave no goal: the places where the robot was
-// stuck, the blocked passages (once), the failed places (their one second try); with still none, a place to look
-// past a frontier from (nearestLookGoal). Done after done_confirmations plans on new maps in a row without a goal;
-// until then, and without a goal, it turns in place. Times are seconds of a monotonic clock (the node uses ROS
-// time); differences within half a nanosecond count as equal. With
+// stuck, the blocked passages (once), the failed places (their one second try); then the way the robot came
+// (its latest trail_length metres of path become passable until the goal they gave ends); with still none, a
+// place to look past a frontier from (nearestLookGoal). Done after done_confirmations plans on new maps in a row
+// without a goal; until then, and without a goal, it turns in place. Times are seconds of a monotonic clock (the
+// node uses ROS time); differences within half a nanosecond count as equal. With
 // background_planning, a plan started at one update is used at the first update after it finished (the robot
 // keeps following its path meanwhile, stands still when its goal ended, and turns in place when it had none);
 // one plan runs at a time.
@@ -132,13 +136,18 @@ class ExplorationPolicy {
   // The wavefront stops past the cheapest goal candidate plus goal_hysteresis (goalCandidates): the nearest goal
   // and the kept one are the same as with costs everywhere.
   static CostMap computeCostMap(const ExplorationPolicyOptions& options, const Blacklist& blacklist,
-                                const std::vector<common::Point2>& blocked_points, const common::OccupancyGrid& map,
+                                const std::vector<common::Point2>& blocked_points,
+                                const std::vector<common::Point2>& trail, const common::OccupancyGrid& map,
                                 const cv::Mat1b& seen_walls, const common::Point2& robot, bool new_map);
   // Starts a plan from `pose` (in the background or in place): takes the pending map, if any.
   void plan(const common::Pose2& pose, double time, ExplorationStep* step);
   // Takes a finished cost map, chooses a goal and a path from `pose`, releasing blocked goals when none is left;
   // counts towards done.
   void choose(CostMap cost_map, const common::Pose2& pose, double time, ExplorationStep* step);
+  // Adds the robot's position to the trail (every 5 cm) and drops what lies beyond trail_length.
+  void recordTrail(const common::Point2& position);
+  // The trail while it is open (plans use it), else none.
+  std::vector<common::Point2> openTrail() const { return trail_open_ ? trail_ : std::vector<common::Point2>(); }
   // Blacklists the goal that just ended (reached or failed) and records failed passages.
   void finishGoal(const common::Pose2& pose, FollowerState outcome, ExplorationStep* step);
 
@@ -149,6 +158,9 @@ class ExplorationPolicy {
   BlockedPassages passages_;
   ObstacleMemory obstacle_memory_;
   SeenWalls seen_walls_;
+  std::vector<common::Point2> trail_;  // the robot's latest trail_length metres of path, oldest first
+  double trail_metres_ = 0.0;           // its length
+  bool trail_open_ = false;             // plans use the trail (from kTrailOpened until the next goal ends)
   double map_time_ = 0.0;  // time of the update that took the last usable map
   PendingMap pending_map_ = PendingMap::kNone;
   common::OccupancyGrid next_map_;

@@ -33,8 +33,8 @@ const common::OptionTable<GridPlannerOptions>& gridPlannerOptionTable();
 
 // Wavefront (Dijkstra) planner on an occupancy grid. Obstacles (value >= occupied_threshold) are inflated by
 // min_clearance with a distance transform; the robot's centre may stand on free cells outside the inflation
-// (unknown cells are neither obstacle nor traversable); cells at least robot_radius from obstacles are roomy (goals
-// go there). Moving between 8-neighbours costs the step's length
+// (unknown cells are neither obstacle nor traversable), and on the free cells of its trail (setTrail); cells at least
+// robot_radius from obstacles are roomy (goals go there). Moving between 8-neighbours costs the step's length
 // (metres) times the mean of the two cells' proximity factors, so paths keep away from walls where they can.
 class GridPlanner {
  public:
@@ -45,6 +45,11 @@ class GridPlanner {
   // Cells within `radius` (metres) of these points (map frame) are neither traversable nor roomy, in this map and
   // the next ones, until set again (an empty list unblocks). Applies at once; the next computeCostsFrom uses it.
   void setBlockedPoints(const std::vector<common::Point2>& points, double radius);
+  // The robot's latest path (map frame, in driving order): the free cells along it are traversable even closer to
+  // obstacles than min_clearance, since the robot's centre was there (a way in that the map then drew narrower),
+  // in this map and the next ones, until set again; blocked points still win. Steps longer than a metre (a
+  // localisation jump) are not drawn. Applies at once.
+  void setTrail(const std::vector<common::Point2>& trail);
   const common::OccupancyGrid& map() const { return map_; }
 
   // Costs from `start` (map frame) to every traversable cell. False (and nothing reachable) when the start lies
@@ -87,6 +92,7 @@ class GridPlanner {
   bool search_bounded_ = false;
   std::vector<common::Point2> blocked_points_;
   double blocked_radius_ = 0.0;
+  std::vector<common::Point2> trail_;
 };
 
 // Length (metres) of a polyline.
