@@ -79,13 +79,16 @@ void GridPlanner::setMap(const common::OccupancyGrid& map) {
     obstacle_distance_ *= static_cast<float>(map.resolution);
   }
   const double band = options_.cost_radius - options_.robot_radius;
+  const auto free = [&](const cv::Point& cell) {
+    const int value = map.cells(cell);
+    return value >= 0 && value <= options_.free_threshold;
+  };
   for (int row = 0; row < rows; ++row)
     for (int col = 0; col < cols; ++col) {
-      const int value = map.cells(row, col);
       const double distance = obstacle_distance_(row, col);
-      const bool free = value >= 0 && value <= options_.free_threshold;
-      if (free && distance >= options_.min_clearance) traversable_(row, col) = 255;
-      if (free && distance >= options_.robot_radius) roomy_(row, col) = 255;
+      const bool is_free = free({col, row});
+      if (is_free && distance >= options_.min_clearance) traversable_(row, col) = 255;
+      if (is_free && distance >= options_.robot_radius) roomy_(row, col) = 255;
       const double closeness = band > 0.0 ? std::clamp((options_.cost_radius - distance) / band, 0.0, 1.0)
                                           : (distance < options_.cost_radius ? 1.0 : 0.0);
       const double narrow = distance < options_.robot_radius ? options_.narrow_cost_factor : 1.0;
@@ -97,10 +100,8 @@ void GridPlanner::setMap(const common::OccupancyGrid& map) {
         !map.cellOf(trail_[i], &col_b, &row_b))
       continue;
     cv::LineIterator cell(traversable_, {col_a, row_a}, {col_b, row_b}, 4);  // the search cuts no corners
-    for (int k = 0; k < cell.count; ++k, ++cell) {
-      const int value = map.cells(cell.pos());
-      if (value >= 0 && value <= options_.free_threshold) traversable_(cell.pos()) = 255;
-    }
+    for (int k = 0; k < cell.count; ++k, ++cell)
+      if (free(cell.pos())) traversable_(cell.pos()) = 255;
   }
   const int blocked_cells = static_cast<int>(std::lround(blocked_radius_ / map.resolution));
   for (const common::Point2& point : blocked_points_) {

@@ -371,7 +371,7 @@ def explore(args, out_dir, log):
                 now = answer.now if answer.reached else run.sim_time()
                 done = "/explorer" in answer.finished
             else:
-                time.sleep(0.05)  # 0.5 s of simulated time at 10x
+                time.sleep(0.05)  # 0.6 s of simulated time at the default 12x
                 now = run.sim_time()
                 done = run.done
             if time.monotonic() - last_written >= PROGRESS_INTERVAL:
