@@ -407,7 +407,10 @@ const common::OptionTable<DefaultOptions>& defaultOptionTable() {
        "share of columns ending on a known pixel for a measured depth", common::between(0, 1)},
       {"default_neighbour_reach", &O::neighbour_reach,
        "m: how far along the wall explored neighbours are looked for", common::atLeast(0)},
-      {"default_min_depth", &O::min_depth, "m: smallest depth taken from the square prior", common::atLeast(0)},
+      {"default_min_depth", &O::min_depth, "m: smallest depth taken from the square prior or the model's room",
+       common::atLeast(0)},
+      {"default_model_depth", &O::model_depth,
+       "1: a rectangle whose depth the map does not show takes the depth of the learned model's room; 0: a square"},
       {"default_max_aspect", &O::max_aspect,
        "a depth measured on known space counts up to this many times the width", common::above(0)},
       {"default_local_frame_radius", &O::local_frame_radius,
@@ -529,10 +532,33 @@ std::vector<std::vector<int>> splitSharedExtents(double resolution, std::vector<
   return siblings;
 }
 
+// Depth of the learned model's room of door d over its extent: per column, the farthest row of the room behind the
+// wall; their median, or -1 when the room reaches fewer than half of the columns.
+double modelRoomDepth(const Frame& f, const DoorFrame& d, const NetworkRoom& room, int max_v) {
+  if (room.box.area() == 0 || room.mask.empty()) return -1.0;
+  const int width = d.right - d.left + 1;
+  const int margin = width / 10;
+  std::vector<int> depths;
+  int columns = 0;
+  for (int u = d.left + margin; u <= d.right - margin; ++u) {
+    ++columns;
+    int farthest = 0;
+    for (int v = d.s0; v <= d.s0 + max_v; ++v) {
+      const cv::Point q = f.at(d, u, v);
+      if (room.box.contains(q) && room.mask(q - room.box.tl())) farthest = v - d.s0 + 1;
+    }
+    if (farthest > 0) depths.push_back(farthest);
+  }
+  if (columns == 0 || 2 * depths.size() < static_cast<size_t>(columns)) return -1.0;
+  return median(depths);
+}
+
 // Step 2, depth: every placed door's depth, measured (measureDepth), else from the explored neighbours
-// (neighbourDepth), else the median of its bounded siblings, else the square prior; depth_source tells which.
+// (neighbourDepth), else the median of its bounded siblings, else the depth of the learned model's room
+// (`model_rooms`, per door; null: none), else the square prior; depth_source tells which.
 void measureDepths(const Frame& f, double resolution, const DefaultOptions& P,
-                   const std::vector<std::vector<int>>& siblings, std::vector<DoorFrame>* doors) {
+                   const std::vector<std::vector<int>>& siblings, const std::vector<NetworkRoom>* model_rooms,
+                   std::vector<DoorFrame>* doors) {
   for (DoorFrame& d : *doors)
     if (d.ok) measureDepth(f, resolution, P, &d);
   for (size_t i = 0; i < doors->size(); ++i) {
@@ -546,6 +572,11 @@ void measureDepths(const Frame& f, double resolution, const DefaultOptions& P,
       for (int j : siblings[i])
         if ((*doors)[j].bounded) sibling_depths.push_back((*doors)[j].depth);
       if (!sibling_depths.empty()) depth = median(sibling_depths);
+    }
+    if (depth < 0 && model_rooms != nullptr) {
+      d.depth_source = 4;
+      depth = modelRoomDepth(f, d, (*model_rooms)[i], static_cast<int>(P.max_extent / resolution));
+      if (depth >= 0) depth = std::max(depth, P.min_depth / resolution);
     }
     if (depth < 0) {
       d.depth_source = 3;
@@ -713,14 +744,16 @@ std::vector<RoomPrediction> mapFrameRooms(const PredictionRequest& request, cons
 }
 
 // The wall-fitted rectangle of every door (steps 1 to 3 of the header); `map_states` is the map's statesOf and
-// `map_known` its known cells (255).
+// `map_known` its known cells (255); `model_rooms` the learned model's room per door for the depth prior (null:
+// none).
 std::vector<RoomPrediction> rectangleRooms(const PredictionRequest& request, const DefaultOptions& P,
-                                           const cv::Mat1b& map_states, const cv::Mat1b& map_known) {
+                                           const cv::Mat1b& map_states, const cv::Mat1b& map_known,
+                                           const std::vector<NetworkRoom>* model_rooms) {
   const double resolution = request.map.resolution;
   const Frame f(map_states, cv::boundingRect(map_states != kUnknownPx));
   std::vector<DoorFrame> doors = framedDoors(request, P, f);
   const std::vector<std::vector<int>> siblings = splitSharedExtents(resolution, &doors);
-  measureDepths(f, resolution, P, siblings, &doors);
+  measureDepths(f, resolution, P, siblings, model_rooms, &doors);
   std::vector<cv::Rect> rects = doorRectangles(f, doors);
   separateOverlaps(f, doors, std::max(1, static_cast<int>(std::lround(P.min_depth / resolution))), &rects);
   const std::vector<cv::Mat1b> masks = roomMasks(f, doors, rects, map_states);
@@ -787,15 +820,12 @@ PredictionResult roomsOnStraightMap(const PredictionRequest& request, const std:
 
   const cv::Mat1b states = statesOf(request.map);
   const cv::Mat1b known = request.map.cells != common::OccupancyGrid::kUnknown;
-  std::vector<RoomPrediction> rectangles = rectangleRooms(request, P, states, known);
   const double resolution = request.map.resolution;
   // Cells within the wall margin of an occupied cell: the unseen rest of the walls the robot saw from one side.
   const double wall_margin = P.wall_margin >= 0.0 ? P.wall_margin : unseenWallMetres(states, resolution);
 
-  std::vector<RoomPrediction> grown = growth.get().rooms;
-
-  // The learned model's room per door (room_network.h), when it chooses or replaces them; on maps too fine for
-  // it the area rule decides.
+  // The learned model's room per door (room_network.h), when it chooses or replaces them (and gives rectangles
+  // their depth where the map shows none); on maps too fine for it the area rule decides.
   const int network = networkReads(resolution) ? P.network : 0;
   std::vector<NetworkRoom> network_rooms;
   if (network > 0) {
@@ -805,6 +835,9 @@ PredictionResult roomsOnStraightMap(const PredictionRequest& request, const std:
     network_rooms = networkRooms(states, network_doors, roomScores(states, resolution, network_doors), resolution,
                                  kNetworkDoorReach);
   }
+  std::vector<RoomPrediction> rectangles =
+      rectangleRooms(request, P, states, known, network > 0 && P.model_depth ? &network_rooms : nullptr);
+  std::vector<RoomPrediction> grown = growth.get().rooms;
   // IoU of a room with the model's room of door i (-1 for a missing room).
   const auto agreement = [&](const RoomPrediction& room, size_t i) {
     if (!room.placed) return -1.0;

@@ -547,12 +547,42 @@ TEST(DefaultPredictor, FarKnownSpaceDoesNotSetTheDepth) {
   EXPECT_LT(uncapped, 0.4);
 }
 
-// Mean IoU of `default` over the benchmark's 44 valid cases; the floor sits a little under the measured mean
-// (0.734), so that a regression fails.
+// Failure pattern 1 of the unseen maps: a room off a bare corridor, 3 m wide and 6 m deep, whose back wall, side
+// walls and neighbours the map does not show. With nothing on the map to give its depth, the rectangle takes the
+// depth of the learned model's room behind the door (default_model_depth) instead of the square's 3 m.
+TEST(DefaultPredictor, ARoomWithNoDepthOnTheMapTakesTheDepthOfTheModelsRoom) {
+  Synthetic s = blankFloor(cv::Size(500, 300));
+  common::OccupancyGrid& map = s.request.map;
+  map.cells(cv::Rect(17, 197, 466, 46)).setTo(common::OccupancyGrid::kOccupied);  // around the corridor
+  map.cells(cv::Rect(20, 200, 460, 40)).setTo(common::OccupancyGrid::kFree);      // corridor, rows 200..239
+  map.cells(cv::Rect(218, 200, 4, 10)).setTo(common::OccupancyGrid::kOccupied);   // stubs at the room's walls
+  map.cells(cv::Rect(278, 200, 4, 10)).setTo(common::OccupancyGrid::kOccupied);
+  s.truth(cv::Rect(220, 77, 60, 120)).setTo(1);  // the hidden room, rows 77..196
+  addDoor(&s, 1, 250, 198.5);
+  s.request.doors.doors[0].width = 0.9;
+  s.request.parameters["default_network"] = 1;  // the model chooses rectangle or grown room
+  const auto predictor = makeRoomPredictor("default");
+  const PredictionResult with_model = predictor->predict(s.request);
+  s.request.parameters["default_model_depth"] = 0;
+  const PredictionResult square = predictor->predict(s.request);
+  ASSERT_EQ(with_model.rooms[0].terms.count("depth_source"), 1u) << "the rectangle was not kept";
+  ASSERT_EQ(square.rooms[0].terms.count("depth_source"), 1u) << "the rectangle was not kept";
+  const double with_iou = scoreOf(s, with_model).iou[0], square_iou = scoreOf(s, square).iou[0];
+  std::printf("depth %.2f m from the model's room, IoU %.3f; as a square %.2f m, IoU %.3f\n",
+              with_model.rooms[0].terms.at("depth"), with_iou, square.rooms[0].terms.at("depth"), square_iou);
+  EXPECT_EQ(with_model.rooms[0].terms.at("depth_source"), 4.0);
+  EXPECT_EQ(square.rooms[0].terms.at("depth_source"), 3.0);
+  EXPECT_NEAR(with_model.rooms[0].terms.at("depth"), 6.0, 0.5);
+  EXPECT_GT(with_iou, 0.85);
+  EXPECT_LT(square_iou, 0.55);
+}
+
+// Mean IoU of `default` over the benchmark's 44 valid cases; the floor, a little under the measured mean (0.740),
+// is the generalization issue's: not below 0.73.
 TEST(DefaultPredictor, KeepsItsAccuracyOnTheBenchmark) {
   HIDDEN_ROOMS_REQUIRE_SHARED_DATA();
   int cases = 0;
-  EXPECT_GE(testing::benchmarkMeanIou("default", &cases), 0.72);
+  EXPECT_GE(testing::benchmarkMeanIou("default", &cases), 0.73);
   EXPECT_EQ(cases, 44);
 }
 

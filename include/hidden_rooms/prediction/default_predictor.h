@@ -31,7 +31,9 @@
 //      default_max_aspect times the width (farther known space is no evidence of the room's back wall: a door
 //      into a large unknown region), else a prior: the
 //      depth of the explored rooms on the same side of the same wall, else of the other hidden rooms on that
-//      side, else the room's width (a square, as the thesis does).
+//      side, else (default_model_depth, with default_network 1 or 3) the depth of the learned model's room (per
+//      column of the extent its farthest row, the median; when it reaches half of the columns), else the room's
+//      width (a square, as the thesis does); either at least default_min_depth.
 // 2. Overlapping rectangles of doors on perpendicular walls: the overlap goes to the door nearer to it (along
 //    that door's normal) and the other room ends where the overlap begins, if it keeps default_min_depth;
 //    other overlaps are cut halfway between the doors.
@@ -51,7 +53,8 @@
 // straight, on a turned map).
 // terms: "rectangle" (1 when the rectangle was chosen), "model_room" (1 when the learned model's room was chosen;
 // it has no terms of its own); a grown room has the thesis's terms, a
-// rectangle "width", "depth" (metres), "depth_bounded" (1 when the depth came from the map, 0 from a prior);
+// rectangle "width", "depth" (metres), "depth_bounded" (1 when the depth came from the map, 0 from a prior),
+// "depth_source" (0 measured, 1 explored neighbours, 2 the other hidden rooms, 3 the square, 4 the model's room);
 // every room "rotation" (the wall angle its door was predicted at, degrees; the map was turned when it is at least
 // default_min_rotation), "outline_clipped" (m^2 removed by the outline clip) and, with a margin, "wall_margin"
 // (metres) and "wall_margin_cut" (m^2 removed by it).
@@ -72,7 +75,8 @@ struct DefaultOptions {
   double max_extent = 25.0;          // m: longest lateral extent and depth searched
   double bounded_fraction = 0.5;     // share of columns ending on a known pixel for a measured depth
   double neighbour_reach = 15.0;     // m: how far along the wall explored neighbours are looked for
-  double min_depth = 2.0;            // m: smallest depth taken from the square prior
+  double min_depth = 2.0;            // m: smallest depth taken from the square prior or the model's room
+  bool model_depth = true;  // network 1 and 3: no depth on the map, the rectangle takes the model's room's depth
   double max_aspect = 2.0;           // a depth measured on known space counts up to this many times the width
   double local_frame_radius = 10.0;  // m: the walls within this of a door give its frame; 0: the map's frame
   double local_frame_tolerance = 2.0;  // degrees: doors whose wall angles differ less share one frame
