@@ -239,18 +239,27 @@ int lateralExtent(const Frame& f, double resolution, const DefaultOptions& P, Do
   return sign * max_u;
 }
 
+// The columns u a door's depth is read over, [first, last]: its extent less a tenth of its width at each end.
+struct DepthColumns {
+  int first = 0, last = -1;
+  int count() const { return std::max(0, last - first + 1); }
+};
+
+DepthColumns depthColumns(const DoorFrame& d) {
+  const int margin = (d.right - d.left + 1) / 10;
+  return {d.left + margin, d.right - margin};
+}
+
 // Per column of the extent, the unknown run behind the wall; sets depth when enough columns end on known space.
 void measureDepth(const Frame& f, double resolution, const DefaultOptions& P, DoorFrame* d) {
   const int max_v = static_cast<int>(P.max_extent / resolution);
   const int width = d->right - d->left + 1;
-  const int margin = width / 10;
+  const DepthColumns columns = depthColumns(*d);
   d->bounded_depths.clear();
-  int columns = 0;
   // A slightly tilted wall (SLAM maps) reaches a few rows past s0 away from the door: a column's run starts
   // after its own wall pixels within that drift.
   const int drift = std::max(1, static_cast<int>(std::lround(kWallDrift / resolution)));
-  for (int u = d->left + margin; u <= d->right - margin; ++u) {
-    ++columns;
+  for (int u = columns.first; u <= columns.last; ++u) {
     int v = d->s0;
     while (v < d->s0 + drift && f.inside(f.at(*d, u, v)) && f.state(f.at(*d, u, v)) != kUnknownPx) ++v;
     for (; v <= d->s0 + max_v; ++v) {
@@ -262,7 +271,7 @@ void measureDepth(const Frame& f, double resolution, const DefaultOptions& P, Do
       }
     }
   }
-  d->bounded = columns > 0 && d->bounded_depths.size() >= P.bounded_fraction * columns;
+  d->bounded = columns.count() > 0 && d->bounded_depths.size() >= P.bounded_fraction * columns.count();
   if (d->bounded) d->depth = median(d->bounded_depths);
   // Known space far beyond the room's proportions is no evidence of its back wall (a door into a large unknown
   // region): the depth is then left to the priors.
@@ -532,16 +541,13 @@ std::vector<std::vector<int>> splitSharedExtents(double resolution, std::vector<
   return siblings;
 }
 
-// Depth of the learned model's room of door d over its extent: per column, the farthest row of the room behind the
-// wall; their median, or -1 when the room reaches fewer than half of the columns.
+// Depth of the learned model's room of door d: per depth column, the farthest row of the room behind the wall;
+// their median, or -1 when the room reaches fewer than half of the columns.
 double modelRoomDepth(const Frame& f, const DoorFrame& d, const NetworkRoom& room, int max_v) {
   if (room.box.area() == 0 || room.mask.empty()) return -1.0;
-  const int width = d.right - d.left + 1;
-  const int margin = width / 10;
+  const DepthColumns columns = depthColumns(d);
   std::vector<int> depths;
-  int columns = 0;
-  for (int u = d.left + margin; u <= d.right - margin; ++u) {
-    ++columns;
+  for (int u = columns.first; u <= columns.last; ++u) {
     int farthest = 0;
     for (int v = d.s0; v <= d.s0 + max_v; ++v) {
       const cv::Point q = f.at(d, u, v);
@@ -549,7 +555,7 @@ double modelRoomDepth(const Frame& f, const DoorFrame& d, const NetworkRoom& roo
     }
     if (farthest > 0) depths.push_back(farthest);
   }
-  if (columns == 0 || 2 * depths.size() < static_cast<size_t>(columns)) return -1.0;
+  if (columns.count() == 0 || 2 * depths.size() < static_cast<size_t>(columns.count())) return -1.0;
   return median(depths);
 }
 

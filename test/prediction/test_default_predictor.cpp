@@ -519,17 +519,25 @@ TEST(DefaultPredictor, PredictsEachDoorInTheFrameOfItsWalls) {
   EXPECT_LT(std::min(global.iou[0], global.iou[1]), 0.7);
 }
 
+// A corridor 2 m wide (40 cells, rows first_row to first_row + 39) across the whole floor, walled round, and above
+// it a wall with a stub 0.5 m into the corridor at each side wall of a room spanning columns [room_left, room_right).
+void addCorridorBelowARoom(Synthetic* s, int first_row, int room_left, int room_right) {
+  common::OccupancyGrid& map = s->request.map;
+  const int width = map.width();
+  map.cells(cv::Rect(17, first_row - 3, width - 34, 46)).setTo(common::OccupancyGrid::kOccupied);
+  map.cells(cv::Rect(20, first_row, width - 40, 40)).setTo(common::OccupancyGrid::kFree);
+  for (int side : {room_left, room_right})
+    map.cells(cv::Rect(side - 2, first_row, 4, 10)).setTo(common::OccupancyGrid::kOccupied);
+}
+
 // A door into a large unknown region (failure pattern 2 of the unseen maps): a 4 m wide room between two wall
 // stubs of a corridor, 5 m deep, and beyond it 11 m more unknown up to a known corridor far away. That corridor
 // is no evidence of the room's back wall: measured depths beyond default_max_aspect times the width give way to
 // the priors (here the square).
 TEST(DefaultPredictor, FarKnownSpaceDoesNotSetTheDepth) {
   Synthetic s = blankFloor(cv::Size(400, 460));
+  addCorridorBelowARoom(&s, 397, 160, 240);
   common::OccupancyGrid& map = s.request.map;
-  map.cells(cv::Rect(17, 393, 366, 47)).setTo(common::OccupancyGrid::kOccupied);  // around the corridor
-  map.cells(cv::Rect(20, 397, 360, 40)).setTo(common::OccupancyGrid::kFree);      // corridor, rows 397..436
-  map.cells(cv::Rect(158, 397, 4, 10)).setTo(common::OccupancyGrid::kOccupied);   // stubs at the room's walls
-  map.cells(cv::Rect(238, 397, 4, 10)).setTo(common::OccupancyGrid::kOccupied);
   map.cells(cv::Rect(17, 17, 366, 46)).setTo(common::OccupancyGrid::kOccupied);   // around a far corridor
   map.cells(cv::Rect(20, 20, 360, 40)).setTo(common::OccupancyGrid::kFree);       // unknown from row 63 on
   s.truth(cv::Rect(160, 293, 80, 100)).setTo(1);  // the hidden room, rows 293..392
@@ -552,11 +560,7 @@ TEST(DefaultPredictor, FarKnownSpaceDoesNotSetTheDepth) {
 // depth of the learned model's room behind the door (default_model_depth) instead of the square's 3 m.
 TEST(DefaultPredictor, ARoomWithNoDepthOnTheMapTakesTheDepthOfTheModelsRoom) {
   Synthetic s = blankFloor(cv::Size(500, 300));
-  common::OccupancyGrid& map = s.request.map;
-  map.cells(cv::Rect(17, 197, 466, 46)).setTo(common::OccupancyGrid::kOccupied);  // around the corridor
-  map.cells(cv::Rect(20, 200, 460, 40)).setTo(common::OccupancyGrid::kFree);      // corridor, rows 200..239
-  map.cells(cv::Rect(218, 200, 4, 10)).setTo(common::OccupancyGrid::kOccupied);   // stubs at the room's walls
-  map.cells(cv::Rect(278, 200, 4, 10)).setTo(common::OccupancyGrid::kOccupied);
+  addCorridorBelowARoom(&s, 200, 220, 280);
   s.truth(cv::Rect(220, 77, 60, 120)).setTo(1);  // the hidden room, rows 77..196
   addDoor(&s, 1, 250, 198.5);
   s.request.doors.doors[0].width = 0.9;
