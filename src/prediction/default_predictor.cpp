@@ -420,6 +420,8 @@ const common::OptionTable<DefaultOptions>& defaultOptionTable() {
        common::atLeast(0)},
       {"default_model_depth", &O::model_depth,
        "1: a rectangle whose depth the map does not show takes the depth of the learned model's room; 0: a square"},
+      {"default_model_min_probability", &O::model_min_probability,
+       "a cell is in the learned model's room when the model's probability is above this", {0, 1, true, true}},
       {"default_max_aspect", &O::max_aspect,
        "a depth measured on known space counts up to this many times the width", common::above(0)},
       {"default_local_frame_radius", &O::local_frame_radius,
@@ -838,8 +840,9 @@ PredictionResult roomsOnStraightMap(const PredictionRequest& request, const std:
     std::vector<NetworkDoor> network_doors;
     for (const common::MapDoor& door : request.doors.doors)
       network_doors.push_back({doorPixel(request.map, door), door.width});
+    const double p = P.model_min_probability;
     network_rooms = networkRooms(states, network_doors, roomScores(states, resolution, network_doors), resolution,
-                                 kNetworkDoorReach);
+                                 kNetworkDoorReach, std::log(p / (1.0 - p)));
   }
   std::vector<RoomPrediction> rectangles =
       rectangleRooms(request, P, states, known, network > 0 && P.model_depth ? &network_rooms : nullptr);

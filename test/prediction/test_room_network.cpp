@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <opencv2/core.hpp>
 
 #include "hidden_rooms/prediction/room_network.h"
@@ -61,6 +63,27 @@ TEST(RoomNetwork, ScoresEveryDoorOnItsWindow) {
   const std::vector<RoomScores> alone = roomScores(states, 0.05, {doors[0]});
   EXPECT_GT(cv::norm(alone[0].logits, scores[0].logits, cv::NORM_INF), 0.0);
   EXPECT_TRUE(roomScores(states, 0.05, {}).empty());
+}
+
+// A door's room takes the cells whose score is above the threshold, connected to the door: hand-made scores of
+// +2 just behind the door, -0.2 (probability 0.45) farther back, -3 elsewhere.
+TEST(RoomNetwork, RoomIsTheConnectedScoresAboveTheThreshold) {
+  const cv::Mat1b states = corridorStates();
+  const std::vector<NetworkDoor> doors{{cv::Point(100, 99), 1.0}};
+  RoomScores scores{cv::Rect(100 - 192, 99 - 192, 384, 384), cv::Mat1f(kWindowCells, kWindowCells, -3.0f)};
+  scores.logits(cv::Rect(44, 43, 9, 5)).setTo(2.0f);   // map rows about 79 to 98
+  scores.logits(cv::Rect(44, 38, 9, 5)).setTo(-0.2f);  // map rows about 59 to 78
+  const auto in_room = [&](double min_logit, int row) {
+    const std::vector<NetworkRoom> rooms = networkRooms(states, doors, {scores}, 0.05, 3, min_logit);
+    EXPECT_EQ(rooms[0].box, cv::Rect(0, 0, 200, 120));
+    return rooms[0].mask(row, 100) > 0;
+  };
+  EXPECT_TRUE(in_room(0.0, 90));
+  EXPECT_FALSE(in_room(0.0, 70));
+  EXPECT_TRUE(in_room(std::log(0.41 / 0.59), 90));
+  EXPECT_TRUE(in_room(std::log(0.41 / 0.59), 70));
+  EXPECT_FALSE(in_room(std::log(0.41 / 0.59), 40));
+  EXPECT_FALSE(in_room(std::log(0.41 / 0.59), 105));  // the corridor is known: never a room
 }
 
 }  // namespace

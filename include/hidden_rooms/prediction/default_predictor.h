@@ -77,6 +77,7 @@ struct DefaultOptions {
   double neighbour_reach = 15.0;     // m: how far along the wall explored neighbours are looked for
   double min_depth = 2.0;            // m: smallest depth taken from the square prior or the model's room
   bool model_depth = true;  // network 1 and 3: no depth on the map, the rectangle takes the model's room's depth
+  double model_min_probability = 0.41;  // a cell is in the model's room above this probability (J / (1 + J))
   double max_aspect = 2.0;           // a depth measured on known space counts up to this many times the width
   double local_frame_radius = 10.0;  // m: the walls within this of a door give its frame; 0: the map's frame
   double local_frame_tolerance = 2.0;  // degrees: doors whose wall angles differ less share one frame
