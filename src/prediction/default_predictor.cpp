@@ -840,9 +840,8 @@ PredictionResult roomsOnStraightMap(const PredictionRequest& request, const std:
     std::vector<NetworkDoor> network_doors;
     for (const common::MapDoor& door : request.doors.doors)
       network_doors.push_back({doorPixel(request.map, door), door.width});
-    const double p = P.model_min_probability;
     network_rooms = networkRooms(states, network_doors, roomScores(states, resolution, network_doors), resolution,
-                                 kNetworkDoorReach, std::log(p / (1.0 - p)));
+                                 kNetworkDoorReach, P.model_min_probability);
   }
   std::vector<RoomPrediction> rectangles =
       rectangleRooms(request, P, states, known, network > 0 && P.model_depth ? &network_rooms : nullptr);

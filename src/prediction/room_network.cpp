@@ -110,12 +110,13 @@ std::vector<RoomScores> roomScores(const cv::Mat1b& states, double resolution, c
 
 std::vector<NetworkRoom> networkRooms(const cv::Mat1b& states, const std::vector<NetworkDoor>& doors,
                                       const std::vector<RoomScores>& scores, double resolution, int reach,
-                                      double min_logit) {
+                                      double min_probability) {
   const cv::Rect image(0, 0, states.cols, states.rows);
-  // Per pixel of the union of the windows, the highest score above min_logit and its door (1-based).
+  // Per pixel of the union of the windows, the highest score above min_probability's log-odds and its door
+  // (1-based).
   cv::Rect all;
   for (const RoomScores& door : scores) all |= door.window & image;
-  cv::Mat1f best(all.size(), static_cast<float>(min_logit));
+  cv::Mat1f best(all.size(), static_cast<float>(std::log(min_probability / (1.0 - min_probability))));
   cv::Mat1i owner(all.size(), 0);
   for (size_t i = 0; i < scores.size(); ++i) {
     const cv::Rect inside = scores[i].window & image;

@@ -1,7 +1,5 @@
 #include <gtest/gtest.h>
 
-#include <cmath>
-
 #include <opencv2/core.hpp>
 
 #include "hidden_rooms/prediction/room_network.h"
@@ -73,17 +71,17 @@ TEST(RoomNetwork, RoomIsTheConnectedScoresAboveTheThreshold) {
   RoomScores scores{cv::Rect(100 - 192, 99 - 192, 384, 384), cv::Mat1f(kWindowCells, kWindowCells, -3.0f)};
   scores.logits(cv::Rect(44, 43, 9, 5)).setTo(2.0f);   // map rows about 79 to 98
   scores.logits(cv::Rect(44, 38, 9, 5)).setTo(-0.2f);  // map rows about 59 to 78
-  const auto in_room = [&](double min_logit, int row) {
-    const std::vector<NetworkRoom> rooms = networkRooms(states, doors, {scores}, 0.05, 3, min_logit);
+  const auto in_room = [&](double min_probability, int row) {
+    const std::vector<NetworkRoom> rooms = networkRooms(states, doors, {scores}, 0.05, 3, min_probability);
     EXPECT_EQ(rooms[0].box, cv::Rect(0, 0, 200, 120));
     return rooms[0].mask(row, 100) > 0;
   };
-  EXPECT_TRUE(in_room(0.0, 90));
-  EXPECT_FALSE(in_room(0.0, 70));
-  EXPECT_TRUE(in_room(std::log(0.41 / 0.59), 90));
-  EXPECT_TRUE(in_room(std::log(0.41 / 0.59), 70));
-  EXPECT_FALSE(in_room(std::log(0.41 / 0.59), 40));
-  EXPECT_FALSE(in_room(std::log(0.41 / 0.59), 105));  // the corridor is known: never a room
+  EXPECT_TRUE(in_room(0.5, 90));
+  EXPECT_FALSE(in_room(0.5, 70));
+  EXPECT_TRUE(in_room(0.41, 90));
+  EXPECT_TRUE(in_room(0.41, 70));
+  EXPECT_FALSE(in_room(0.41, 40));
+  EXPECT_FALSE(in_room(0.41, 105));  // the corridor is known: never a room
 }
 
 }  // namespace

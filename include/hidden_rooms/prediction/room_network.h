@@ -58,11 +58,11 @@ struct NetworkRoom {
 };
 
 // Per door its room as the network sees it: the unknown pixels of `states` where the door's score (bilinearly
-// interpolated from its cells) is above `min_logit` and the highest of all doors', the parts of them 4-connected
-// to the door's disc grown by `reach` pixels; `box` is the door's window within the map. `scores` as roomScores
-// gives them.
+// interpolated from its cells) is the highest of all doors' and gives a probability above `min_probability`
+// (in (0, 1)), the parts of them 4-connected to the door's disc grown by `reach` pixels; `box` is the door's window
+// within the map. `scores` as roomScores gives them.
 std::vector<NetworkRoom> networkRooms(const cv::Mat1b& states, const std::vector<NetworkDoor>& doors,
                                       const std::vector<RoomScores>& scores, double resolution, int reach,
-                                      double min_logit = 0.0);
+                                      double min_probability);
 
 }  // namespace hidden_rooms::prediction
