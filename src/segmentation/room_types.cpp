@@ -49,6 +49,44 @@ std::vector<int> roomsBehind(const std::vector<std::set<int>>& neighbours) {
   return behind;
 }
 
+// Per room: the share of shortest paths between two other rooms of its part of the graph that pass through it
+// (betweenness centrality, Brandes's algorithm; paths counted once per pair, in [0, 1]). Corridors carry the paths.
+std::vector<double> betweenness(const std::vector<std::set<int>>& neighbours) {
+  const int count = static_cast<int>(neighbours.size());
+  std::vector<double> centrality(count, 0.0);
+  for (int source = 0; source < count; ++source) {
+    std::vector<int> order, distance(count, -1);
+    std::vector<double> paths(count, 0.0), dependency(count, 0.0);
+    std::vector<std::vector<int>> predecessors(count);
+    std::vector<int> queue = {source};
+    distance[source] = 0;
+    paths[source] = 1.0;
+    for (size_t head = 0; head < queue.size(); ++head) {
+      const int room = queue[head];
+      order.push_back(room);
+      for (const int other : neighbours[room]) {
+        if (distance[other] < 0) {
+          distance[other] = distance[room] + 1;
+          queue.push_back(other);
+        }
+        if (distance[other] == distance[room] + 1) {
+          paths[other] += paths[room];
+          predecessors[other].push_back(room);
+        }
+      }
+    }
+    for (auto it = order.rbegin(); it != order.rend(); ++it) {
+      for (const int previous : predecessors[*it])
+        dependency[previous] += paths[previous] / paths[*it] * (1.0 + dependency[*it]);
+      if (*it != source) centrality[*it] += dependency[*it];
+    }
+  }
+  // Each pair was counted from both ends; normalized by the pairs of the other rooms.
+  const double pairs = count > 2 ? static_cast<double>(count - 1) * (count - 2) : 1.0;
+  for (double& value : centrality) value /= pairs;
+  return centrality;
+}
+
 double outlineLength(const common::Polygon& outline) {
   double length = 0.0;
   for (size_t i = 0; i < outline.size(); ++i) length += (outline[(i + 1) % outline.size()] - outline[i]).norm();
@@ -93,7 +131,7 @@ const std::vector<std::string>& roomFeatureNames() {
       "area",        "width",       "elongation",  "width_uniformity", "long_side",       "short_side",
       "aspect",      "rectangularity", "compactness", "passages",      "neighbours",      "relative_area",
       "area_rank",   "largest_neighbour_ratio", "dead_end_neighbours", "passage_share",
-      "neighbour_elongation", "neighbour_degree", "rooms_behind"};
+      "neighbour_elongation", "neighbour_degree", "rooms_behind", "betweenness"};
   return names;
 }
 
@@ -121,6 +159,7 @@ cv::Mat1f roomFeatures(const SegmentedFloor& floor) {
     elongations.push_back(room.width > 0.0 ? room.area / (room.width * room.width) : 0.0);
   }
   const std::vector<int> behind = roomsBehind(neighbours);
+  const std::vector<double> central = betweenness(neighbours);
   std::vector<double> sorted = areas;
   std::sort(sorted.begin(), sorted.end());
   const double median = sorted[sorted.size() / 2];
@@ -161,6 +200,7 @@ cv::Mat1f roomFeatures(const SegmentedFloor& floor) {
         neighbour_elongation,
         neighbour_degree,
         static_cast<double>(behind[i]),
+        central[i],
     };
     for (size_t j = 0; j < values.size(); ++j) features(static_cast<int>(i), static_cast<int>(j)) = static_cast<float>(values[j]);
   }

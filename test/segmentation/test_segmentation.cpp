@@ -258,6 +258,34 @@ TEST(RoomTypes, ACorridorNeedsMostOfTheVotes) {
   for (const int type : found) EXPECT_LT(type, static_cast<int>(roomTypeNames().size()));
 }
 
+// Betweenness on a hand-made graph: rooms 1 to 4 in a ring, room 5 off room 1. Of the six pairs of the other rooms,
+// room 1 lies on every shortest path of 5-2, 5-4, 5-3 and on one of the two of 2-4 (3.5 / 6); room 2 on one of two
+// of 1-3 and of 5-3 (1 / 6); room 3 on one of two of 2-4 (0.5 / 6); room 5 on none.
+TEST(RoomTypes, BetweennessIsTheShareOfShortestPathsThroughARoom) {
+  SegmentedFloor floor;
+  for (int label = 1; label <= 5; ++label) {
+    Room room;
+    room.label = label;
+    room.area = 4.0;
+    room.width = 2.0;
+    room.outline = {{0.0, 0.0}, {2.0, 0.0}, {2.0, 2.0}, {0.0, 2.0}};
+    floor.rooms.push_back(room);
+  }
+  for (const auto& [a, b] : std::vector<std::pair<int, int>>{{1, 2}, {2, 3}, {3, 4}, {4, 1}, {1, 5}}) {
+    Passage passage;
+    passage.room_a = a;
+    passage.room_b = b;
+    passage.width = 0.9;
+    floor.passages.push_back(passage);
+  }
+  const auto& names = roomFeatureNames();
+  const int column = static_cast<int>(std::find(names.begin(), names.end(), "betweenness") - names.begin());
+  ASSERT_LT(column, static_cast<int>(names.size()));
+  const cv::Mat1f features = roomFeatures(floor);
+  const std::vector<double> expected = {3.5 / 6.0, 1.0 / 6.0, 0.5 / 6.0, 1.0 / 6.0, 0.0};
+  for (int room = 0; room < 5; ++room) EXPECT_NEAR(features(room, column), expected[room], 1e-6) << "room " << room + 1;
+}
+
 TEST(RoomGraph, TheEnvironmentXmlReadsBackWithTheSameRoomsAndDoors) {
   const FloorWithDoors input;
   const SegmentedFloor floor = segmentFloor(input.drawn.map, input.doors, input.predicted, {});

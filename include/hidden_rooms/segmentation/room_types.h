@@ -2,7 +2,7 @@
 
 // Room types of a segmented floor, learned from the thesis's labelled floor plans: each room's shape, size, and
 // place in the topological map (doors, neighbours) as features, a random forest (OpenCV ml) as classifier. The
-// shipped model (models/room_types.yml.gz, built into the library) is trained by train_room_types.
+// shipped model (models/room_types.yml, built into the library) is trained by train_room_types.
 
 #include <cstdint>
 #include <memory>
@@ -33,7 +33,7 @@ const std::vector<std::string>& roomFeatureNames();
 
 class RoomTypeClassifier {
  public:
-  // The model of the library (models/room_types.yml.gz).
+  // The model of the library (models/room_types.yml).
   static const RoomTypeClassifier& shipped();
   // A model as train_room_types writes it (OpenCV FileStorage text). Throws InputError when it does not read.
   static RoomTypeClassifier fromText(const std::string& model_text, const std::string& source_name);
