@@ -434,6 +434,9 @@ const common::OptionTable<DefaultOptions>& defaultOptionTable() {
        "grown rooms less than this many times the rectangle give way", common::atLeast(0)},
       {"default_stub_length", &O::stub_length, "m: wall stubs this long into the explored side end an extent",
        common::atLeast(0)},
+      {"default_stub_by_model", &O::stub_by_model,
+       "1 (default_network 1 and 3): a rectangle laid out past the stubs replaces the stubbed one when most of the "
+       "cells it adds are in the learned model's room; 0: stubs always end rectangles"},
       {"default_outline_reach", &O::outline_reach,
        "m: band beside a room within which the known map's extent bounds it", common::atLeast(0)},
       {"default_wall_margin", &O::wall_margin,
@@ -854,6 +857,22 @@ PredictionResult roomsOnStraightMap(const PredictionRequest& request, const std:
     const double either = cv::countNonZero(room.mask) + cv::countNonZero(seen.mask) - both;
     return either > 0 ? both / either : 0.0;
   };
+  // A stub may be where the rooms behind the wall end or only where an explored wall meets it: a door's rectangle
+  // laid out past the stubs stands in for the stubbed one when most of the cells it adds are the model's room.
+  if (network > 0 && P.stub_length > 0.0 && P.stub_by_model) {
+    DefaultOptions past_stubs = P;
+    past_stubs.stub_length = 0.0;
+    std::vector<RoomPrediction> unstubbed =
+        rectangleRooms(request, past_stubs, states, known, P.model_depth ? &network_rooms : nullptr);
+    for (size_t i = 0; i < rectangles.size(); ++i) {
+      const NetworkRoom& seen = network_rooms[i];
+      if (!unstubbed[i].placed || !rectangles[i].placed || seen.box.area() == 0) continue;
+      const cv::Mat1b added = unstubbed[i].mask & ~rectangles[i].mask;
+      const int count = cv::countNonZero(added);
+      if (count > 0 && 2 * cv::countNonZero(added(seen.box) & seen.mask) > count)
+        rectangles[i] = std::move(unstubbed[i]);
+    }
+  }
   // Door i's grown room replaced by the model's room (which has no terms of its own).
   std::vector<bool> use_model(rectangles.size(), false);
   const auto take_model_room = [&](size_t i) {

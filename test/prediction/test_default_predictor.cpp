@@ -555,6 +555,30 @@ TEST(DefaultPredictor, FarKnownSpaceDoesNotSetTheDepth) {
   EXPECT_LT(uncapped, 0.4);
 }
 
+// A stub that is no room's end: a hidden room 13 m wide (columns 20 to 279, the corridor's whole length) and 4.5 m
+// deep behind a corridor with pilasters, stubs 0.5 m into it at columns 160 and 240; its door at 200, nothing known
+// beyond it. The stubbed rectangle ends at the stubs (and so does the room without the learned model's say); the
+// rectangle past them agrees more with the model's room and spans the room.
+TEST(DefaultPredictor, TheLearnedModelDecidesWhetherAStubEndsARoom) {
+  Synthetic s = blankFloor(cv::Size(300, 260));
+  addCorridorBelowARoom(&s, 197, 160, 240);
+  s.truth(cv::Rect(20, 103, 260, 91)).setTo(1);
+  addDoor(&s, 1, 200, 195.5);
+  const auto predictor = makeRoomPredictor("default");
+  for (const int network : {1, 3}) {
+    s.request.parameters["default_network"] = network;
+    s.request.parameters["default_stub_by_model"] = 1;
+    const PredictionResult by_model = predictor->predict(s.request);
+    s.request.parameters["default_stub_by_model"] = 0;
+    const double stubbed = scoreOf(s, predictor->predict(s.request)).iou[0];
+    const double past_stubs = scoreOf(s, by_model).iou[0];
+    std::printf("default_network %d: IoU %.3f with the model's say on stubs (rectangle %g), %.3f stubbed\n", network,
+                past_stubs, by_model.rooms[0].terms.at("rectangle"), stubbed);
+    EXPECT_GT(past_stubs, 0.85) << "default_network " << network;
+    EXPECT_LT(stubbed, 0.4) << "default_network " << network;
+  }
+}
+
 // Failure pattern 1 of the unseen maps: a room off a bare corridor, 3 m wide and 6 m deep, whose back wall, side
 // walls and neighbours the map does not show. With nothing on the map to give its depth, the rectangle takes the
 // depth of the learned model's room behind the door (default_model_depth) instead of the square's 3 m.
@@ -565,6 +589,9 @@ TEST(DefaultPredictor, ARoomWithNoDepthOnTheMapTakesTheDepthOfTheModelsRoom) {
   addDoor(&s, 1, 250, 198.5);
   s.request.doors.doors[0].width = 0.9;
   s.request.parameters["default_network"] = 1;  // the model chooses rectangle or grown room
+  // The stubs bound this room; the model's room runs on along the bare corridor past them, so with its say on
+  // stubs the rectangle spans the corridor (IoU 0.12). On real maps that say gains (docs/results.md).
+  s.request.parameters["default_stub_by_model"] = 0;
   const auto predictor = makeRoomPredictor("default");
   const PredictionResult with_model = predictor->predict(s.request);
   s.request.parameters["default_model_depth"] = 0;
@@ -581,7 +608,7 @@ TEST(DefaultPredictor, ARoomWithNoDepthOnTheMapTakesTheDepthOfTheModelsRoom) {
   EXPECT_LT(square_iou, 0.55);
 }
 
-// Mean IoU of `default` over the benchmark's 44 valid cases; the floor, a little under the measured mean (0.741),
+// Mean IoU of `default` over the benchmark's 44 valid cases; the floor, a little under the measured mean (0.743),
 // is the generalization issue's: not below 0.73.
 TEST(DefaultPredictor, KeepsItsAccuracyOnTheBenchmark) {
   HIDDEN_ROOMS_REQUIRE_SHARED_DATA();

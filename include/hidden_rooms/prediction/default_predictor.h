@@ -40,7 +40,9 @@
 // 3. The rectangle's unknown pixels connected to the door; pixels claimed by several rooms go to the nearest
 //    door.
 // Lateral extent and wall stubs: a stub ends the extent unless the wall goes on past it at another row (the side
-// wall of a door niche or of a step in the wall: no free space beyond it and wall pixels within its length).
+// wall of a door niche or of a step in the wall: no free space beyond it and wall pixels within its length). With
+// the learned model (default_stub_by_model), the rectangles are also laid out with stubs ignored, and a door takes
+// that rectangle when most of the cells it adds to the stubbed one are in the model's room.
 //
 // Every room, grown or rectangle, is then clipped to the known map's outline beside it (clipToKnownOutline,
 // default_outline_reach): a room does not stick out of the building past the outer walls its neighbours show; a
@@ -84,6 +86,7 @@ struct DefaultOptions {
   double min_rotation = 1.0;         // degrees: maps turned less are not predicted turned straight
   double grown_area_ratio = 1.25;    // network 0: grown rooms less than this many times the rectangle give way
   double stub_length = 0.3;          // m: wall stubs this long into the explored side end a room's extent
+  bool stub_by_model = true;  // network 1 and 3: past the stubs when most of what that adds is the model's room
   double outline_reach = 15.0;       // m: band beside a room within which the known map's extent bounds it
   double wall_margin = -1.0;         // m: unseen wall thickness left out of rooms; < 0: estimated from the map
   int network = 3;  // the learned room model: 0 unused; 1 chooses rectangle or grown room; 2 its rooms; 3 the
