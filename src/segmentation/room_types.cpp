@@ -49,8 +49,9 @@ std::vector<int> roomsBehind(const std::vector<std::set<int>>& neighbours) {
   return behind;
 }
 
-// Per room: the share of shortest paths between two other rooms of its part of the graph that pass through it
-// (betweenness centrality, Brandes's algorithm; paths counted once per pair, in [0, 1]). Corridors carry the paths.
+// Per room: over all pairs of other rooms, the mean share of their shortest paths that pass through it
+// (betweenness centrality, Brandes's algorithm; in [0, 1]; rooms in different parts of the graph have no path).
+// Corridors carry the paths.
 std::vector<double> betweenness(const std::vector<std::set<int>>& neighbours) {
   const int count = static_cast<int>(neighbours.size());
   std::vector<double> centrality(count, 0.0);
@@ -81,7 +82,7 @@ std::vector<double> betweenness(const std::vector<std::set<int>>& neighbours) {
       if (*it != source) centrality[*it] += dependency[*it];
     }
   }
-  // Each pair was counted from both ends; normalized by the pairs of the other rooms.
+  // Each pair was counted from both ends, and (count - 1)(count - 2) is twice the number of pairs of other rooms.
   const double pairs = count > 2 ? static_cast<double>(count - 1) * (count - 2) : 1.0;
   for (double& value : centrality) value /= pairs;
   return centrality;

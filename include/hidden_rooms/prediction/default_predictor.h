@@ -86,7 +86,7 @@ struct DefaultOptions {
   double min_rotation = 1.0;         // degrees: maps turned less are not predicted turned straight
   double grown_area_ratio = 1.25;    // network 0: grown rooms less than this many times the rectangle give way
   double stub_length = 0.3;          // m: wall stubs this long into the explored side end a room's extent
-  bool stub_by_model = true;  // network 1 and 3: past the stubs when most of what that adds is the model's room
+  bool stub_by_model = true;  // network 1, 3: stubs give way where the cells past them are mostly the model's room
   double outline_reach = 15.0;       // m: band beside a room within which the known map's extent bounds it
   double wall_margin = -1.0;         // m: unseen wall thickness left out of rooms; < 0: estimated from the map
   int network = 3;  // the learned room model: 0 unused; 1 chooses rectangle or grown room; 2 its rooms; 3 the
