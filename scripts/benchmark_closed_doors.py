@@ -133,11 +133,30 @@ def load_cases(bench_dir, part=None):
     return cases
 
 
+def content_box(image, truth, unknown):
+    """(left, top, right, bottom), right and bottom exclusive: the bounding box of the known cells and true rooms
+    (the whole image when it has neither)."""
+    known = image != unknown
+    if known.ndim == 3:
+        known = known.any(axis=2)
+    rows, columns = np.nonzero(known | (truth > 0))
+    if rows.size == 0:
+        return 0, 0, image.shape[1], image.shape[0]
+    return int(columns.min()), int(rows.min()), int(columns.max()) + 1, int(rows.max()) + 1
+
+
+def content_margins(image, truth, unknown):
+    """Cells between content_box and the image's left, top, right and bottom edges."""
+    left, top, right, bottom = content_box(image, truth, unknown)
+    return np.array([left, top, image.shape[1] - right, image.shape[0] - bottom])
+
+
 def turned_case(case, degrees, root):
     """The case turned counter-clockwise by `degrees` about its map's centre, written under ROOT/ENV/CASE: as a SLAM
-    map whose frame starts off the building's axes. The map and the true rooms are resampled (nearest cell) onto a
-    grid that holds the whole turned map, unknown outside; the doors move with them (their orientation swaps at odd
-    quarter turns); the reference rooms are left out. Returns the turned Case."""
+    map whose frame starts off the building's axes. The map and the true rooms are resampled (nearest cell), unknown
+    outside, onto a grid around the turned building with the straight map's margin on each side (a quarter turn
+    moves every cell exactly); the doors move with them (their orientation swaps at odd quarter turns); the
+    reference rooms are left out. Returns the turned Case."""
     folder = os.path.join(root, case.env, case.name)
     os.makedirs(folder, exist_ok=True)
     with open(case.path("map.yaml")) as stream:
@@ -152,15 +171,21 @@ def turned_case(case, degrees, root):
     turn[0, 2] += (new_width - width) / 2.0
     turn[1, 2] += (new_height - height) / 2.0
     unknown = 205 if image.dtype == np.uint8 else int(205 / 255 * np.iinfo(image.dtype).max)
-    cv2.imwrite(os.path.join(folder, "map.png"), cv2.warpAffine(
-        image, turn, (new_width, new_height), flags=cv2.INTER_NEAREST, borderValue=unknown))
-    cv2.imwrite(os.path.join(folder, "gt_rooms.png"), cv2.warpAffine(
-        truth, turn, (new_width, new_height), flags=cv2.INTER_NEAREST, borderValue=0))
+    quarter_turns = int(round(degrees / 90.0))
+    turned_image = cv2.warpAffine(image, turn, (new_width, new_height), flags=cv2.INTER_NEAREST, borderValue=unknown)
+    turned_truth = cv2.warpAffine(truth, turn, (new_width, new_height), flags=cv2.INTER_NEAREST, borderValue=0)
+    # The grid is then cut as the case's own is: around the turned building (known cells and true rooms) with the
+    # margin the straight map has on each side, so that turning changes the angle and not how far the map reaches.
+    margins = np.roll(content_margins(image, truth, unknown), -quarter_turns)
+    left, top, right, bottom = content_box(turned_image, turned_truth, unknown)
+    left, top = max(0, left - int(margins[0])), max(0, top - int(margins[1]))
+    right, bottom = min(new_width, right + int(margins[2])), min(new_height, bottom + int(margins[3]))
+    cv2.imwrite(os.path.join(folder, "map.png"), turned_image[top:bottom, left:right])
+    cv2.imwrite(os.path.join(folder, "gt_rooms.png"), turned_truth[top:bottom, left:right])
     resolution = float(meta["resolution"])
     origin_x, origin_y = float(meta["origin"][0]), float(meta["origin"][1])
     with open(case.path("doors.yaml")) as stream:
         doors = yaml.safe_load(stream)
-    quarter_turns = int(round(degrees / 90.0))
     for door in doors["doors"]:
         x, y = door["position"]
         # Pixel centres sit at whole coordinates for OpenCV; rows count down from the map's top.
@@ -170,6 +195,8 @@ def turned_case(case, degrees, root):
                             float(origin_y + (new_height - new_row - 0.5) * resolution)]
         if quarter_turns % 2 and door.get("orientation") in ("O", "V"):
             door["orientation"] = "V" if door["orientation"] == "O" else "O"
+    # The cut grid keeps the frame of the whole turned one.
+    meta["origin"] = [origin_x + left * resolution, origin_y + (new_height - bottom) * resolution, 0.0]
     with open(os.path.join(folder, "doors.yaml"), "w") as stream:
         yaml.safe_dump(doors, stream)
     meta["image"] = "map.png"

@@ -14,6 +14,7 @@ import sys
 import tempfile
 import unittest
 
+import cv2
 import numpy as np
 
 PACKAGE_DIR = os.path.dirname(os.path.dirname(os.path.dirname(os.path.realpath(__file__))))
@@ -178,6 +179,13 @@ class SmallBenchmark(unittest.TestCase):
             straight_doors, turned_doors = yaml.safe_load(a)["doors"], yaml.safe_load(b)["doors"]
         for straight, turned in zip(straight_doors, turned_doors):
             self.assertNotEqual(straight["orientation"], turned["orientation"])
+        # A small turn keeps the margin the map has around its building on each side.
+        small = module.turned_case(case, 3.0, root)
+        with open(case.path("map.yaml")) as stream:
+            image = cv2.imread(case.path(yaml.safe_load(stream)["image"]), cv2.IMREAD_UNCHANGED)
+        turned_image = cv2.imread(small.path("map.png"), cv2.IMREAD_UNCHANGED)
+        np.testing.assert_array_equal(module.content_margins(turned_image, module.read_label_image(
+            small.path("gt_rooms.png")), 205), module.content_margins(image, truth, 205))
         result = run_script(self.folder, "--method", self.method, "--jobs", "2", "--binary", self.binary,
                             "--turn", "3")
         self.assertEqual(result.returncode, 0, result.stdout + result.stderr)
