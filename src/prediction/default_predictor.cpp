@@ -21,7 +21,7 @@ namespace {
 // Working states of a pixel; map values at or above kOccupiedFrom are walls.
 constexpr uint8_t kUnknownPx = 0, kFreePx = 1, kOccupiedPx = 2;
 constexpr int8_t kOccupiedFrom = 50;
-constexpr double kWallDrift = 0.15;  // m: how far past the door's first unknown row a tilted wall may reach
+constexpr double kWallDrift = 0.15;  // m: how far a tilted or resampled wall's cells stray from its row
 constexpr int kNetworkDoorReach = 3;  // pixels: the learned model's room touches its door's disc grown by this
 
 cv::Mat1b statesOf(const common::OccupancyGrid& map) {
@@ -186,6 +186,13 @@ bool isWallStep(const Frame& f, const DoorFrame& d, int u_after, int step, int v
   return false;
 }
 
+// Whether a cell of column u within `reach` rows of row v is known.
+bool knownNear(const Frame& f, const DoorFrame& d, int u, int v, int reach) {
+  for (int t = -reach; t <= reach; ++t)
+    if (f.state(f.at(d, u, v + t)) != kUnknownPx) return true;
+  return false;
+}
+
 // How far the room reaches along the wall in direction `sign`.
 int lateralExtent(const Frame& f, double resolution, const DefaultOptions& P, DoorFrame* d, int sign) {
   const int max_u = static_cast<int>(P.max_extent / resolution);
@@ -196,6 +203,7 @@ int lateralExtent(const Frame& f, double resolution, const DefaultOptions& P, Do
   // The wall is tracked: its rows may drift by a few pixels (slightly tilted walls of SLAM maps).
   int band0 = d->band0, band1 = d->s0 - 1;
   const int persistence = std::max(2, static_cast<int>(std::lround(0.15 / resolution)));
+  const int drift = std::max(1, static_cast<int>(std::lround(kWallDrift / resolution)));
   int known_run = 0;
   const int stub_px = P.stub_length > 0.0 ? std::max(2, static_cast<int>(std::lround(P.stub_length / resolution))) : 0;
   const int max_stub_width = std::max(2, static_cast<int>(1.0 / resolution));
@@ -206,9 +214,10 @@ int lateralExtent(const Frame& f, double resolution, const DefaultOptions& P, Do
       d->lateral_open = true;
       return sign * std::max(k - 1, last_wall);
     }
-    // Known space behind the wall over a few columns: a perpendicular wall of an explored room.
+    // Known space behind the wall over a few columns: a perpendicular wall of an explored room. Each probe reads
+    // the cells within the wall drift of its row, where a tilted or resampled wall's cells fall.
     int known = 0;
-    for (int v : {band1 + 2, band1 + probe1, band1 + probe2}) known += f.state(f.at(*d, u, v)) != kUnknownPx;
+    for (int v : {band1 + 2, band1 + probe1, band1 + probe2}) known += knownNear(f, *d, u, v, drift);
     if (known >= 2) {
       if (++known_run >= persistence) return sign * (k - known_run);
     } else {

@@ -278,24 +278,46 @@ Synthetic syntheticFromStates(const cv::Mat1b& states, const cv::Mat1w& truth,
   return result;
 }
 
+// A 240 x 160 state image: a corridor (rows 99 to 138) whose wall (rows 95 to 98) faces an unknown block, and a
+// known service corridor above that block (rows 5 to 16), which bounds the depth of the rooms in it.
+cv::Mat1b corridorUnderAnUnknownBlock() {
+  cv::Mat1b states(cv::Size(240, 160), 0);
+  states(cv::Rect(17, 95, 206, 48)).setTo(2);   // around the corridor
+  states(cv::Rect(20, 99, 200, 40)).setTo(1);   // corridor
+  states(cv::Rect(17, 2, 206, 18)).setTo(2);    // around the service corridor
+  states(cv::Rect(20, 5, 200, 12)).setTo(1);
+  return states;
+}
+
+// IoU of the first door's wall-fitted rectangle alone (default_network 0, no grown room) against the true room
+// `room` (label 1 on its unknown cells).
+double rectangleIou(const cv::Mat1b& states, const cv::Rect& room, const cv::Point2d& door) {
+  cv::Mat1w truth = cv::Mat1w::zeros(states.size());
+  truth(room).setTo(1);
+  truth.setTo(0, states != 0);
+  Synthetic s = syntheticFromStates(states, truth, {door});
+  s.request.parameters["default_network"] = 0;
+  s.request.parameters["default_grown_area_ratio"] = 1000.0;
+  return scoreOf(s, makeRoomPredictor("default")->predict(s.request)).iou[0];
+}
+
 // A hidden room above a corridor whose door sits at the back of a shallow niche: the niche's side walls run
 // from the door's line to the corridor's wall, which is not a pillar standing free; the room spans the wall.
 TEST(DefaultPredictor, NicheSideWallsAreNotStubs) {
-  const cv::Size size(240, 160);
-  cv::Mat1b states(size, 0);
-  states(cv::Rect(17, 95, 206, 48)).setTo(2);   // around the corridor
-  states(cv::Rect(20, 99, 200, 40)).setTo(1);   // corridor
-  states(cv::Rect(17, 2, 206, 18)).setTo(2);    // around a service corridor above the room
-  states(cv::Rect(20, 5, 200, 12)).setTo(1);
+  cv::Mat1b states = corridorUnderAnUnknownBlock();
   states(cv::Rect(97, 89, 26, 10)).setTo(2);    // the niche's walls and the door's line
   states(cv::Rect(100, 92, 20, 7)).setTo(1);    // the niche
-  cv::Mat1w truth = cv::Mat1w::zeros(size);
-  truth(cv::Rect(20, 20, 200, 75)).setTo(1);
-  truth.setTo(0, states != 0);
-  Synthetic s = syntheticFromStates(states, truth, {{110, 90}});
-  s.request.parameters["default_network"] = 0;  // the area rule, with:
-  s.request.parameters["default_grown_area_ratio"] = 1000.0;  // the wall-fitted rectangle only
-  EXPECT_GT(scoreOf(s, makeRoomPredictor("default")->predict(s.request)).iou[0], 0.9);
+  EXPECT_GT(rectangleIou(states, cv::Rect(20, 20, 200, 75), {110, 90}), 0.9);
+}
+
+// A hidden room above a corridor and, beside it behind the same wall, an explored strip 0.3 m deep whose back wall
+// lies between the rows that tell known space behind the wall: read cell by cell those rows missed the back wall,
+// and the room ran on behind the strip to the wall's end (IoU 0.04; read within the wall drift 0.94).
+TEST(DefaultPredictor, KnownSpaceBehindTheWallEndsTheRoomWithinTheWallDrift) {
+  cv::Mat1b states = corridorUnderAnUnknownBlock();
+  states(cv::Rect(118, 88, 102, 7)).setTo(2);   // the strip's walls: its back wall is row 88
+  states(cv::Rect(120, 89, 100, 6)).setTo(1);   // the strip
+  EXPECT_GT(rectangleIou(states, cv::Rect(20, 20, 98, 75), {70, 96}), 0.85);
 }
 
 // A block of unknown between a north corridor and a west corridor, bounded by known space to the south and
@@ -608,7 +630,7 @@ TEST(DefaultPredictor, ARoomWithNoDepthOnTheMapTakesTheDepthOfTheModelsRoom) {
   EXPECT_LT(square_iou, 0.55);
 }
 
-// Mean IoU of `default` over the benchmark's 44 valid cases; the floor, a little under the measured mean (0.743),
+// Mean IoU of `default` over the benchmark's 44 valid cases; the floor, a little under the measured mean (0.760),
 // is the generalization issue's: not below 0.73.
 TEST(DefaultPredictor, KeepsItsAccuracyOnTheBenchmark) {
   HIDDEN_ROOMS_REQUIRE_SHARED_DATA();
