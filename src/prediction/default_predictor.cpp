@@ -61,6 +61,9 @@ class Frame {
   cv::Rect box_;
 };
 
+// kWallDrift in pixels of a map of `resolution` (m per pixel), at least one.
+int wallDriftPixels(double resolution) { return std::max(1, static_cast<int>(std::lround(kWallDrift / resolution))); }
+
 int median(std::vector<int> values) {
   std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
   return values[values.size() / 2];
@@ -107,7 +110,9 @@ double unseenWallMetres(const cv::Mat1b& states, double resolution) {
   const int typical = std::max_element(counts.begin(), counts.end(), [](const auto& a, const auto& b) {
                         return a.second < b.second;
                       })->first;
-  return std::max(0, typical - median(one_sided)) * resolution;
+  // A SLAM map draws each wall face in the cell its surface lies in, about a cell into the space it was seen from:
+  // a wall seen from both sides shows one such cell more than one seen from one side.
+  return std::max(0, typical - median(one_sided) - 1) * resolution;
 }
 
 // Unknown fraction of the strip behind the door (width of the door, `depth` pixels) on side n.
@@ -203,7 +208,7 @@ int lateralExtent(const Frame& f, double resolution, const DefaultOptions& P, Do
   // The wall is tracked: its rows may drift by a few pixels (slightly tilted walls of SLAM maps).
   int band0 = d->band0, band1 = d->s0 - 1;
   const int persistence = std::max(2, static_cast<int>(std::lround(0.15 / resolution)));
-  const int drift = std::max(1, static_cast<int>(std::lround(kWallDrift / resolution)));
+  const int drift = wallDriftPixels(resolution);
   int known_run = 0;
   const int stub_px = P.stub_length > 0.0 ? std::max(2, static_cast<int>(std::lround(P.stub_length / resolution))) : 0;
   const int max_stub_width = std::max(2, static_cast<int>(1.0 / resolution));
@@ -267,7 +272,7 @@ void measureDepth(const Frame& f, double resolution, const DefaultOptions& P, Do
   d->bounded_depths.clear();
   // A slightly tilted wall (SLAM maps) reaches a few rows past s0 away from the door: a column's run starts
   // after its own wall pixels within that drift.
-  const int drift = std::max(1, static_cast<int>(std::lround(kWallDrift / resolution)));
+  const int drift = wallDriftPixels(resolution);
   for (int u = columns.first; u <= columns.last; ++u) {
     int v = d->s0;
     while (v < d->s0 + drift && f.inside(f.at(*d, u, v)) && f.state(f.at(*d, u, v)) != kUnknownPx) ++v;
@@ -347,6 +352,20 @@ cv::Rect endBefore(const DoorFrame& d, cv::Rect room, const cv::Rect& box) {
   return room;
 }
 
+// The transform turning an image of `size` by -angle (radians) about its centre onto a grid large enough for all
+// of it, whose size it sets in `turned_size`.
+cv::Matx23d straighteningTransform(const cv::Size& size, double angle, cv::Size* turned_size) {
+  const double c = std::abs(std::cos(angle)), s = std::abs(std::sin(angle));
+  turned_size->width = static_cast<int>(std::ceil(c * size.width + s * size.height)) + 2;
+  turned_size->height = static_cast<int>(std::ceil(s * size.width + c * size.height)) + 2;
+  // The turn about the image's centre, then that centre moved to the turned grid's.
+  cv::Matx23d forward = cv::getRotationMatrix2D(cv::Point2f(size.width / 2.0f, size.height / 2.0f),
+                                                angle * 180.0 / CV_PI, 1.0);
+  forward(0, 2) += (turned_size->width - size.width) / 2.0;
+  forward(1, 2) += (turned_size->height - size.height) / 2.0;
+  return forward;
+}
+
 // Rotation of a point about the working transform.
 cv::Point2d applyAffine(const cv::Matx23d& m, const cv::Point2d& p) {
   return {m(0, 0) * p.x + m(0, 1) * p.y + m(0, 2), m(1, 0) * p.x + m(1, 1) * p.y + m(1, 2)};
@@ -412,7 +431,18 @@ double dominantWallAngle(const common::OccupancyGrid& map, size_t max_points) {
   return best;
 }
 
-double unseenWallThickness(const common::OccupancyGrid& map) { return unseenWallMetres(statesOf(map), map.resolution); }
+double unseenWallThickness(const common::OccupancyGrid& map) { return unseenWallThickness(map, dominantWallAngle(map)); }
+
+double unseenWallThickness(const common::OccupancyGrid& map, double wall_angle) {
+  // Read across the walls: the states turned straight by nearest cell, which keeps each wall's thickness (a
+  // linear resampling would thicken thin walls), so that the runs cross turned walls square. Beyond the map's
+  // edge each cell takes its edge cell's state: the edge is no unknown space.
+  cv::Size size;
+  const cv::Matx23d forward = straighteningTransform(map.cells.size(), wall_angle, &size);
+  cv::Mat1b straight;
+  cv::warpAffine(statesOf(map), straight, cv::Mat(forward), size, cv::INTER_NEAREST, cv::BORDER_REPLICATE);
+  return unseenWallMetres(straight, map.resolution);
+}
 
 const common::OptionTable<DefaultOptions>& defaultOptionTable() {
   using O = DefaultOptions;
@@ -788,15 +818,10 @@ struct StraightRequest {
 };
 
 StraightRequest turnedStraight(const PredictionRequest& request, double angle) {
-  const cv::Size size = request.map.cells.size();
-  const double c = std::abs(std::cos(angle)), s = std::abs(std::sin(angle));
-  const int W = static_cast<int>(std::ceil(c * size.width + s * size.height)) + 2;
-  const int H = static_cast<int>(std::ceil(s * size.width + c * size.height)) + 2;
   StraightRequest straight;
-  // The turn about the map's centre, then that centre moved to the turned grid's.
-  straight.forward = cv::getRotationMatrix2D(cv::Point2f(size.width / 2.0f, size.height / 2.0f), angle * 180.0 / CV_PI, 1.0);
-  straight.forward(0, 2) += (W - size.width) / 2.0;
-  straight.forward(1, 2) += (H - size.height) / 2.0;
+  cv::Size turned_size;
+  straight.forward = straighteningTransform(request.map.cells.size(), angle, &turned_size);
+  const int W = turned_size.width, H = turned_size.height;
   // Each state turned with linear interpolation, so that a turned wall stays a closed line (nearest-pixel
   // sampling breaks a thin wall into steps with gaps): a cell is a wall when walls cover a quarter of it, else
   // free when free space covers half of it, else unknown.
@@ -841,8 +866,9 @@ PredictionResult roomsOnStraightMap(const PredictionRequest& request, const std:
   const cv::Mat1b states = statesOf(request.map);
   const cv::Mat1b known = request.map.cells != common::OccupancyGrid::kUnknown;
   const double resolution = request.map.resolution;
-  // Cells within the wall margin of an occupied cell: the unseen rest of the walls the robot saw from one side.
-  const double wall_margin = P.wall_margin >= 0.0 ? P.wall_margin : unseenWallMetres(states, resolution);
+  // Cells within the wall margin of an occupied cell: the unseen rest of the walls the robot saw from one side
+  // (predict estimates a negative margin from the map before this).
+  const double wall_margin = std::max(0.0, P.wall_margin);
 
   // The learned model's room per door (room_network.h), when it chooses or replaces them (and gives rectangles
   // their depth where the map shows none); on maps too fine for it the area rule decides.
@@ -1058,10 +1084,12 @@ PredictionResult DefaultPredictor::predict(const PredictionRequest& request) con
   DefaultOptions P;
   common::applyOptionValues(defaultOptionTable(), values, &P, "parameter ");
   common::validateOptions(defaultOptionTable(), P, "parameter ");
-
   // A turned map (every SLAM map is a little) is predicted turned straight, where the layout's cells and the
   // rectangles are axis-aligned, and its rooms are turned back; each door in the frame of the walls around it.
   const PredictionFrames frames = predictionFrames(request, P);
+  // The unseen wall thickness is the map's: measured on its cells as given, not on a copy resampled straight
+  // (resampling thickens thin walls), and shared by every frame.
+  if (P.wall_margin < 0.0) P.wall_margin = unseenWallThickness(request.map, frames.angles[0]);
   PredictionResult result;
   result.rooms.resize(request.doors.doors.size());
   for (size_t g = 0; g < frames.angles.size(); ++g) {

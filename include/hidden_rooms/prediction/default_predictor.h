@@ -48,7 +48,8 @@
 // default_outline_reach): a room does not stick out of the building past the outer walls its neighbours show; a
 // side where nothing is known beyond the door is left open. Last, every room leaves out the unknown cells within default_wall_margin of a wall cell: a wall the robot saw
 // from one side shows only its near face in a SLAM map, and the rest of its thickness is no room's. A negative
-// margin (the default) is estimated from the map (unseenWallThickness): 0 on maps that draw whole walls.
+// margin (the default) is estimated from the map as given (unseenWallThickness), once for all its frames: 0 on maps
+// that draw whole walls.
 //
 // Parameters: start_search_radius and the default_* keys (config/prediction.yaml), and the layout's
 // (config/layout.yaml) for the grown rooms; --debug-dir receives the layout's images (of the map turned
@@ -123,11 +124,15 @@ class DefaultPredictor : public RoomPredictor {
 double dominantWallAngle(const common::OccupancyGrid& map, size_t max_points = 20000);
 
 // How much of the thickness of walls seen from one side a map does not show, metres: the most common length
-// (3 pixels to 1 m) of the runs along rows and columns that cross a wall seen from both sides (from a free cell,
-// starting and ending on an occupied cell, to the next free cell; the wall's inside may be unknown) less the median
-// occupied run between a free and an unknown cell (a wall seen from one side). 0 when the map draws whole walls,
-// or has fewer than 20 runs of either kind.
+// (3 pixels to 1 m) of the runs across the walls that cross a wall seen from both sides (from a free cell, starting
+// and ending on an occupied cell, to the next free cell; the wall's inside may be unknown) less the median
+// occupied run between a free and an unknown cell (a wall seen from one side), less one cell (the cell a SLAM map
+// draws a wall face in reaches past the face, and a wall seen from both sides has one such face more). The runs
+// follow the rows and columns of the map turned straight by its dominantWallAngle by nearest cell, which thickens
+// no wall. 0 when the map draws whole walls, or has fewer than 20 runs of either kind.
 double unseenWallThickness(const common::OccupancyGrid& map);
+// The same, given the map's dominantWallAngle (radians).
+double unseenWallThickness(const common::OccupancyGrid& map, double wall_angle);
 
 // Clips a room (mask, image frame) to the known map's extent beside it: x to the known pixels of the rows within
 // `reach` pixels of the room's rows, y likewise from its columns, so that a room does not stick out of the
