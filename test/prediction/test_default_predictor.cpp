@@ -345,15 +345,22 @@ TEST(DefaultPredictor, OverlapOfPerpendicularDoorsGoesToTheNearerDoor) {
   for (size_t k = 0; k < scores.iou.size(); ++k) EXPECT_GT(scores.iou[k], 0.9) << "door " << k + 1;
 }
 
+// Working states (0 unknown, 1 free, 2 wall) of eight rooms (40 x 64 pixels, x from 8 every 48, y 8..71) side by
+// side above a corridor (y 80..111), walls 8 pixels thick, on a 400 x 120 image of wall.
+cv::Mat1b roomsAlongACorridor() {
+  cv::Mat1b states(120, 400, static_cast<uint8_t>(2));
+  states(cv::Rect(8, 80, 384, 32)).setTo(1);
+  for (int x = 8; x + 40 <= 392; x += 48) states(cv::Rect(x, 8, 40, 64)).setTo(1);
+  return states;
+}
+
 // Rooms side by side along a corridor, as a SLAM map draws them: each wall face a cell into the space it was seen
 // from. Seen from both sides (the free corridor and free rooms) the walls cross 8 pixels, 6 of wall (0.3 m); a
 // room behind a closed door shows only its corridor wall's near face (2 pixels, 1 of them wall) and the rest is
 // unknown: 5 pixels (0.25 m) unseen. A map that draws whole walls shows none unseen.
 TEST(DefaultPredictor, EstimatesTheUnseenWallThickness) {
   const auto floor = [](int shown) {
-    cv::Mat1b states(120, 400, static_cast<uint8_t>(2));
-    states(cv::Rect(8, 80, 384, 32)).setTo(1);                   // the corridor
-    for (int x = 8; x + 40 <= 392; x += 48) states(cv::Rect(x, 8, 40, 64)).setTo(1);  // rooms, 8 px walls
+    cv::Mat1b states = roomsAlongACorridor();
     // The middle rooms are hidden: unknown behind the near `shown` rows of their corridor wall.
     for (int x : {152, 200}) states(cv::Rect(x, 8, 40, 64 + 8 - shown)).setTo(0);
     return syntheticFromStates(states, cv::Mat1w::zeros(states.size()), {});
@@ -365,9 +372,7 @@ TEST(DefaultPredictor, EstimatesTheUnseenWallThickness) {
 // The margin keeps the unseen part of the door's wall out of the room: with the walls of a hidden room shown only
 // by their near faces, the room ends a wall's thickness from them.
 TEST(DefaultPredictor, LeavesTheUnseenWallsOutOfTheRooms) {
-  cv::Mat1b states(120, 400, static_cast<uint8_t>(2));
-  states(cv::Rect(8, 80, 384, 32)).setTo(1);
-  for (int x = 8; x + 40 <= 392; x += 48) states(cv::Rect(x, 8, 40, 64)).setTo(1);
+  cv::Mat1b states = roomsAlongACorridor();
   states(cv::Rect(144, 0, 56, 78)).setTo(0);  // a hidden room (x 152..191, y 8..71) and its walls, but the near
   cv::Mat1w truth = cv::Mat1w::zeros(states.size());  // 2 rows of the corridor wall, unknown
   truth(cv::Rect(152, 8, 40, 64)).setTo(1);
@@ -388,9 +393,7 @@ TEST(DefaultPredictor, LeavesTheUnseenWallsOutOfTheRooms) {
 // Doors that share one place (their rectangles split the shared wall down to nothing) or crowd at the map's corner
 // once failed the whole prediction with an OpenCV error; now each door gets its own room or its own problem.
 TEST(DefaultPredictor, DoorsAtOnePlaceOrCrowdedAtTheEdgeArePredictedOneByOne) {
-  cv::Mat1b states(120, 400, static_cast<uint8_t>(2));
-  states(cv::Rect(8, 80, 384, 32)).setTo(1);
-  for (int x = 8; x + 40 <= 392; x += 48) states(cv::Rect(x, 8, 40, 64)).setTo(1);
+  cv::Mat1b states = roomsAlongACorridor();
   states(cv::Rect(144, 0, 56, 78)).setTo(0);  // the hidden room of the doors
   cv::Mat1w truth = cv::Mat1w::zeros(states.size());
   truth(cv::Rect(152, 8, 40, 64)).setTo(1);
@@ -506,9 +509,7 @@ TEST(DefaultPredictor, KeepsTheUnseenWallThicknessOnATurnedMap) {
   cv::Mat1b states(300, 560, static_cast<uint8_t>(0));
   const cv::Rect floor(80, 90, 400, 120);
   cv::Mat1b inside = states(floor);
-  inside.setTo(2);
-  inside(cv::Rect(8, 80, 384, 32)).setTo(1);                                          // the corridor
-  for (int x = 8; x + 40 <= 392; x += 48) inside(cv::Rect(x, 8, 40, 64)).setTo(1);  // rooms
+  roomsAlongACorridor().copyTo(inside);
   for (int x = 20; x < 392; x += 24) inside(cv::Rect(x, 80, 2, 32)).setTo(2);  // thin partitions, 2 pixels
   for (int x = 8; x + 40 <= 392; x += 48) inside(cv::Rect(x, 40, 40, 2)).setTo(2);  // and across the rooms
   for (const cv::Rect& outside : {cv::Rect(0, 0, 400, 6), cv::Rect(0, 114, 400, 6), cv::Rect(0, 0, 6, 120),
