@@ -366,6 +366,14 @@ cv::Matx23d straighteningTransform(const cv::Size& size, double angle, cv::Size*
   return forward;
 }
 
+// A well-mixed hash of a pixel's position (the splitmix64 finalizer).
+uint64_t cellHash(const cv::Point& p) {
+  uint64_t h = (static_cast<uint64_t>(static_cast<uint32_t>(p.x)) << 32) | static_cast<uint32_t>(p.y);
+  h = (h ^ (h >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  h = (h ^ (h >> 27)) * 0x94d049bb133111ebULL;
+  return h ^ (h >> 31);
+}
+
 // Rotation of a point about the working transform.
 cv::Point2d applyAffine(const cv::Matx23d& m, const cv::Point2d& p) {
   return {m(0, 0) * p.x + m(0, 1) * p.y + m(0, 2), m(1, 0) * p.x + m(1, 1) * p.y + m(1, 2)};
@@ -398,9 +406,12 @@ double dominantWallAngle(const common::OccupancyGrid& map, size_t max_points) {
   std::vector<cv::Point> cells;
   cv::findNonZero(map.cells >= kOccupiedFrom, cells);
   if (cells.empty()) return 0.0;
-  const size_t stride = cells.size() / std::max<size_t>(1, max_points) + 1;  // evenly thinned: same profiles
+  // Thinned to about max_points cells, each kept by a hash of its position: every k-th cell in raster order
+  // would form a sheared lattice on solid wall blocks, whose own rows would pass for the walls' direction.
+  const uint64_t stride = cells.size() / std::max<size_t>(1, max_points) + 1;
   std::vector<cv::Point2d> points;
-  for (size_t k = 0; k < cells.size(); k += stride) points.emplace_back(cells[k].x, cells[k].y);
+  for (const cv::Point& cell : cells)
+    if (stride == 1 || cellHash(cell) % stride == 0) points.emplace_back(cell.x, cell.y);
   const double diagonal = std::hypot(map.width(), map.height());
   const int bins = static_cast<int>(std::ceil(2.0 * diagonal)) + 2;
   std::vector<int> along(bins), across(bins);

@@ -119,8 +119,8 @@ class DefaultPredictor : public RoomPredictor {
 
 // Dominant wall direction of a map, radians in [-pi/4, pi/4): the walls run along this angle and the one
 // perpendicular to it (image frame: x = column, y = row). The angle whose projection profiles of the occupied
-// cells (along it and across it) are sharpest, searched to 0.02 degrees, on at most `max_points` of them (evenly
-// thinned beyond). 0 when the map has no occupied cells.
+// cells (along it and across it) are sharpest, searched to 0.02 degrees, on about `max_points` of them at most
+// (beyond, each kept by a hash of its position). 0 when the map has no occupied cells.
 double dominantWallAngle(const common::OccupancyGrid& map, size_t max_points = 20000);
 
 // How much of the thickness of walls seen from one side a map does not show, metres: the most common length
