@@ -366,17 +366,17 @@ cv::Matx23d straighteningTransform(const cv::Size& size, double angle, cv::Size*
   return forward;
 }
 
+// Rotation of a point about the working transform.
+cv::Point2d applyAffine(const cv::Matx23d& m, const cv::Point2d& p) {
+  return {m(0, 0) * p.x + m(0, 1) * p.y + m(0, 2), m(1, 0) * p.x + m(1, 1) * p.y + m(1, 2)};
+}
+
 // A well-mixed hash of a pixel's position (the splitmix64 finalizer).
 uint64_t cellHash(const cv::Point& p) {
   uint64_t h = (static_cast<uint64_t>(static_cast<uint32_t>(p.x)) << 32) | static_cast<uint32_t>(p.y);
   h = (h ^ (h >> 30)) * 0xbf58476d1ce4e5b9ULL;
   h = (h ^ (h >> 27)) * 0x94d049bb133111ebULL;
   return h ^ (h >> 31);
-}
-
-// Rotation of a point about the working transform.
-cv::Point2d applyAffine(const cv::Matx23d& m, const cv::Point2d& p) {
-  return {m(0, 0) * p.x + m(0, 1) * p.y + m(0, 2), m(1, 0) * p.x + m(1, 1) * p.y + m(1, 2)};
 }
 
 }  // namespace

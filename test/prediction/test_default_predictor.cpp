@@ -105,26 +105,6 @@ TEST(DefaultPredictor, RecoversRoomsOfARotatedMap) {
   for (size_t k = 0; k < scores.iou.size(); ++k) EXPECT_GT(scores.iou[k], 0.7) << "door " << k + 1;
 }
 
-TEST(DefaultPredictor, FindsTheWallAngleOfSolidWallBlocks) {
-  // Thick walls drawn solid give far more wall cells than the angle is measured on: thinned in the cells' raster
-  // order they would form a sheared lattice, whose own rows would pass for the walls' direction.
-  for (const double degrees : {0.0, 7.0, 20.0}) {
-    cv::Mat1b states(600, 600, static_cast<uint8_t>(1));
-    cv::rectangle(states, cv::Rect(100, 100, 400, 400), 2, cv::FILLED);
-    cv::rectangle(states, cv::Rect(200, 250, 200, 100), 1, cv::FILLED);
-    cv::Mat1b turned;
-    cv::warpAffine(states, turned, cv::getRotationMatrix2D(cv::Point2f(300.0f, 300.0f), degrees, 1.0), states.size(),
-                   cv::INTER_NEAREST, cv::BORDER_CONSTANT, cv::Scalar(0));
-    common::OccupancyGrid map;
-    map.resolution = 0.05;
-    map.cells = cv::Mat_<int8_t>(turned.size(), common::OccupancyGrid::kUnknown);
-    map.cells.setTo(common::OccupancyGrid::kFree, turned == 1);
-    map.cells.setTo(common::OccupancyGrid::kOccupied, turned == 2);
-    ASSERT_GT(cv::countNonZero(turned == 2), 100000);
-    EXPECT_NEAR(std::abs(dominantWallAngle(map)) * 180.0 / CV_PI, degrees, 0.5) << degrees << " degrees";
-  }
-}
-
 TEST(DefaultPredictor, MeasuresDepthBehindARaggedWall) {
   // A SLAM map's wall, turned back by the dominant angle, is ragged: away from the door its pixels reach a row
   // or two past the door's first unknown row (here row 96 at door 1, in 3 of 4 columns). The depth is measured
@@ -485,6 +465,20 @@ Synthetic turned(const Synthetic& s, double degrees) {
     door.position = common::Point2(q.x * s.request.map.resolution, (size.height - q.y) * s.request.map.resolution);
   }
   return out;
+}
+
+TEST(DefaultPredictor, FindsTheWallAngleOfSolidWallBlocks) {
+  // Thick walls drawn solid give far more wall cells than the angle is measured on: thinned in the cells' raster
+  // order they would form a sheared lattice, whose own rows would pass for the walls' direction.
+  cv::Mat1b states(600, 600, static_cast<uint8_t>(1));
+  cv::rectangle(states, cv::Rect(100, 100, 400, 400), 2, cv::FILLED);
+  cv::rectangle(states, cv::Rect(200, 250, 200, 100), 1, cv::FILLED);
+  const Synthetic block = syntheticFromStates(states, cv::Mat1w::zeros(states.size()), {});
+  for (const double degrees : {0.0, 7.0, 20.0}) {
+    const common::OccupancyGrid map = turned(block, degrees).request.map;
+    ASSERT_GT(cv::countNonZero(map.cells == common::OccupancyGrid::kOccupied), 100000);
+    EXPECT_NEAR(std::abs(dominantWallAngle(map)) * 180.0 / CV_PI, degrees, 0.5) << degrees << " degrees";
+  }
 }
 
 // A hidden room beside an explored one, both shallower than wide, with the outside beyond their far walls: a
