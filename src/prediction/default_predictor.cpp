@@ -366,11 +366,6 @@ cv::Matx23d straighteningTransform(const cv::Size& size, double angle, cv::Size*
   return forward;
 }
 
-// Rotation of a point about the working transform.
-cv::Point2d applyAffine(const cv::Matx23d& m, const cv::Point2d& p) {
-  return {m(0, 0) * p.x + m(0, 1) * p.y + m(0, 2), m(1, 0) * p.x + m(1, 1) * p.y + m(1, 2)};
-}
-
 // A well-mixed hash of a pixel's position (the splitmix64 finalizer).
 uint64_t cellHash(const cv::Point& p) {
   uint64_t h = (static_cast<uint64_t>(static_cast<uint32_t>(p.x)) << 32) | static_cast<uint32_t>(p.y);
@@ -852,8 +847,8 @@ StraightRequest turnedStraight(const PredictionRequest& request, double angle) {
   straight.request.doors = request.doors;
   for (common::MapDoor& door : straight.request.doors.doors) {
     const common::Point2 image = request.map.toImage(door.position);
-    const cv::Point2d q = applyAffine(straight.forward, cv::Point2d(image.x(), image.y()));
-    door.position = common::Point2(q.x * map.resolution, (H - q.y) * map.resolution);
+    const cv::Vec2d q = straight.forward * cv::Vec3d(image.x(), image.y(), 1.0);
+    door.position = common::Point2(q[0] * map.resolution, (H - q[1]) * map.resolution);
   }  // |angle| < 45 degrees: each door's wall stays closest to the axis its orientation names
   straight.request.parameters = request.parameters;
   straight.request.debug_dir = request.debug_dir;

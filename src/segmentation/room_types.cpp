@@ -5,6 +5,8 @@
 #include <map>
 #include <set>
 
+#include <boost/graph/adjacency_list.hpp>
+#include <boost/graph/betweenness_centrality.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/ml.hpp>
 
@@ -50,41 +52,20 @@ std::vector<int> roomsBehind(const std::vector<std::set<int>>& neighbours) {
 }
 
 // Per room: over all pairs of other rooms, the mean share of their shortest paths that pass through it
-// (betweenness centrality, Brandes's algorithm; in [0, 1]; rooms in different parts of the graph have no path).
-// Corridors carry the paths.
+// (betweenness centrality by Brandes's algorithm, Boost.Graph's; in [0, 1]; rooms in different parts of the graph
+// have no path). Corridors carry the paths.
 std::vector<double> betweenness(const std::vector<std::set<int>>& neighbours) {
+  using Graph = boost::adjacency_list<boost::vecS, boost::vecS, boost::undirectedS>;
   const int count = static_cast<int>(neighbours.size());
+  Graph graph(count);
+  for (int room = 0; room < count; ++room)
+    for (const int other : neighbours[room])
+      if (room < other) boost::add_edge(room, other, graph);
   std::vector<double> centrality(count, 0.0);
-  for (int source = 0; source < count; ++source) {
-    std::vector<int> order, distance(count, -1);
-    std::vector<double> paths(count, 0.0), dependency(count, 0.0);
-    std::vector<std::vector<int>> predecessors(count);
-    std::vector<int> queue = {source};
-    distance[source] = 0;
-    paths[source] = 1.0;
-    for (size_t head = 0; head < queue.size(); ++head) {
-      const int room = queue[head];
-      order.push_back(room);
-      for (const int other : neighbours[room]) {
-        if (distance[other] < 0) {
-          distance[other] = distance[room] + 1;
-          queue.push_back(other);
-        }
-        if (distance[other] == distance[room] + 1) {
-          paths[other] += paths[room];
-          predecessors[other].push_back(room);
-        }
-      }
-    }
-    for (auto it = order.rbegin(); it != order.rend(); ++it) {
-      for (const int previous : predecessors[*it])
-        dependency[previous] += paths[previous] / paths[*it] * (1.0 + dependency[*it]);
-      if (*it != source) centrality[*it] += dependency[*it];
-    }
-  }
-  // Each pair was counted from both ends, and (count - 1)(count - 2) is twice the number of pairs of other rooms.
-  const double pairs = count > 2 ? static_cast<double>(count - 1) * (count - 2) : 1.0;
-  for (double& value : centrality) value /= pairs;
+  const auto map = boost::make_iterator_property_map(centrality.begin(), boost::get(boost::vertex_index, graph));
+  boost::brandes_betweenness_centrality(graph, boost::centrality_map(map));
+  // Boost's relative form divides by the (count - 1)(count - 2) / 2 pairs of other rooms, none below three rooms.
+  if (count > 2) boost::relative_betweenness_centrality(graph, map);
   return centrality;
 }
 
